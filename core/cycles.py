@@ -1,0 +1,317 @@
+"""Speed traces: the paper's trapezoid generator (§2.2), NEDC, and CSV drive cycles.
+
+Generator (paper §2.2). Around a mean speed ``v̄`` the driver swings between
+``v1 = v̄·(1 − dv)`` and ``v2 = v̄·(1 + dv)`` with acceleration ``ε_d·v̇_max``:
+``t_a = (v2 − v1)/(ε_d·v̇_max)``, ``t_p = t_NEDC/k``, ``t_k = t_p/2 − t_a``. One wave goes from
+``v̄`` up to ``v2`` (``t_a/2``), holds ``t_k``, down to ``v1`` (``t_a``), holds ``t_k`` and back to
+``v̄`` (``t_a/2``); its mean speed is exactly ``v̄``. After each wave the van cruises at ``v̄``
+for ``t_0``.
+
+Traffic law (ours; the paper leaves ``t_0(ε_t)`` open): ``t_0 = t_p·(1 − ε_t)/ε_t``. Dense
+traffic (``ε_t → 1``) leaves no cruising between waves (stop and go), ``ε_t = 0.5`` cruises as
+long as a wave lasts, light traffic (``ε_t → 0``) is nearly constant speed.
+
+Each leg starts and ends at rest, with ramps at ``ε_d·v̇_max`` (a driver with ``ε_d = 0``, who
+keeps a constant speed as in the paper's Fig. 10, ramps like a calm driver), and covers its
+distance exactly. The generator is deterministic: the same inputs give the same trace.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from core.arrays import FloatArray
+from core.exceptions import InvalidParameterError
+from core.params import CALM_DRIVER, NEDC_DURATION_S, StreetType
+
+KMH = 1 / 3.6
+
+
+def trace_distance_m(speed_mps: FloatArray, dt_s: float) -> float:
+    """Distance of a speed trace [m]: trapezoid rule, the mean of each step's end speeds."""
+    if speed_mps.size < 2:
+        return 0.0
+    return float((speed_mps[:-1] + speed_mps[1:]).sum() * 0.5 * dt_s)
+
+
+def _wave_breakpoints(
+    street: StreetType, accel_mps2: float, traffic_density: float
+) -> tuple[FloatArray, FloatArray]:
+    """Times [s] and speeds [m/s] of one trapezoid wave plus its cruise, starting at ``v̄``."""
+    v_mean = street.mean_speed_mps
+    v1 = v_mean * (1 - street.speed_variation)
+    v2 = v_mean * (1 + street.speed_variation)
+    period_s = NEDC_DURATION_S / street.period_divisor
+    t_a = (v2 - v1) / accel_mps2 if accel_mps2 > 0 else math.inf
+    cruise_s = period_s * (1 - traffic_density) / traffic_density
+    if not math.isfinite(t_a) or v2 == v1:
+        return np.array([0.0, period_s + cruise_s]), np.array([v_mean, v_mean])
+    # A driver too calm for the wave to fit in t_p stretches it (t_k = 0).
+    t_k = max(period_s / 2 - t_a, 0.0)
+    steps = [0.0, t_a / 2, t_k, t_a, t_k, t_a / 2, cruise_s]
+    speeds = [v_mean, v2, v2, v1, v1, v_mean, v_mean]
+    return np.cumsum(steps), np.array(speeds)
+
+
+def generate_leg(
+    distance_m: float,
+    street: StreetType,
+    driver_aggressiveness: float,
+    max_acceleration_mps2: float,
+    traffic_density: float | None = None,
+    dt_s: float = 1.0,
+) -> FloatArray:
+    """A speed trace for one leg, from rest to rest, covering ``distance_m`` (paper §2.2).
+
+    Parameters
+    ----------
+    distance_m
+        Leg distance [m], >= 0. A zero-length leg gives a single sample at rest.
+    street
+        Street type (mean speed, dv, k, default traffic density).
+    driver_aggressiveness
+        ε_d [–], 0…1: share of the maximum acceleration the driver uses.
+    max_acceleration_mps2
+        v̇_max [m/s²].
+    traffic_density
+        ε_t [–] in (0, 1); None takes the street type's default.
+    dt_s
+        Sampling interval [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Speed samples [m/s] every ``dt_s``, first and last 0; their trapezoid distance equals
+        ``distance_m`` to rounding.
+    """
+    _check_leg_inputs(distance_m, driver_aggressiveness, traffic_density, dt_s)
+    if distance_m == 0:
+        return np.zeros(1)
+    density = street.traffic_density if traffic_density is None else traffic_density
+    accel = driver_aggressiveness * max_acceleration_mps2
+    ramp_accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2
+    v_mean = street.mean_speed_mps
+
+    wave_t, wave_v = _wave_breakpoints(street, accel, density)
+    wave_length_m = v_mean * wave_t[-1]
+    n_waves = int(distance_m // wave_length_m) + 2
+    ramp_s = v_mean / ramp_accel
+    offsets = ramp_s + wave_t[-1] * np.arange(n_waves)
+    times = np.concatenate(([0.0], (offsets[:, None] + wave_t[None, :]).ravel()))
+    speeds = np.concatenate(([0.0], np.tile(wave_v, n_waves)))
+    grid = np.arange(0.0, times[-1] + dt_s, dt_s)
+    outbound = np.interp(grid, times, speeds)
+
+    # Cut where the distance so far plus the braking distance reaches the target; this sum
+    # never decreases while |dv/dt| <= ramp_accel, so the first crossing is the cut.
+    travelled = np.concatenate(([0.0], np.cumsum(0.5 * (outbound[:-1] + outbound[1:]) * dt_s)))
+    reach = travelled + outbound**2 / (2 * ramp_accel)
+    cut = int(np.searchsorted(reach, distance_m)) if reach[-1] >= distance_m else len(reach) - 1
+    cut = max(cut, 1)
+    v_cut = outbound[cut]
+    n_brake = max(math.ceil(v_cut / (ramp_accel * dt_s)), 1)
+    braking = v_cut * (1 - np.arange(1, n_brake + 1) / n_brake)
+    trace = np.concatenate((outbound[: cut + 1], braking))
+    return trace * (distance_m / trace_distance_m(trace, dt_s))
+
+
+def stretch_to_duration(speed_mps: FloatArray, dt_s: float, duration_s: float) -> FloatArray:
+    """Stretch a trace in time to last ``duration_s`` while covering the same distance.
+
+    Used when a client's road router gives a leg's duration: the generated shape is kept, time
+    is scaled by ``duration / original duration`` and speed by its inverse.
+
+    Parameters
+    ----------
+    speed_mps
+        Speed samples [m/s] every ``dt_s`` [s], starting and ending at rest.
+    duration_s
+        Target duration [s], > 0.
+    """
+    if speed_mps.size < 2 or duration_s <= 0:
+        return speed_mps
+    distance = trace_distance_m(speed_mps, dt_s)
+    old_t = np.arange(speed_mps.size) * dt_s
+    n_steps = max(round(duration_s / dt_s), 1)
+    new_t = np.linspace(0.0, old_t[-1], n_steps + 1)
+    stretched = np.interp(new_t, old_t, speed_mps)
+    total = trace_distance_m(stretched, dt_s)
+    return stretched * (distance / total) if total > 0 else stretched
+
+
+def _check_leg_inputs(
+    distance_m: float, driver_aggressiveness: float, traffic_density: float | None, dt_s: float
+) -> None:
+    if not (math.isfinite(distance_m) and distance_m >= 0):
+        raise InvalidParameterError(
+            f"distance_m must be finite and >= 0, got {distance_m}", "distance_m"
+        )
+    if not 0 <= driver_aggressiveness <= 1:
+        raise InvalidParameterError(
+            f"driver_aggressiveness must be within 0..1, got {driver_aggressiveness}",
+            "driver_aggressiveness",
+        )
+    if traffic_density is not None and not 0 < traffic_density < 1:
+        raise InvalidParameterError(
+            f"traffic_density must be strictly between 0 and 1, got {traffic_density}",
+            "traffic_density",
+        )
+    if not (math.isfinite(dt_s) and dt_s > 0):
+        raise InvalidParameterError(f"dt_s must be finite and > 0, got {dt_s}", "dt_s")
+
+
+# --- Standard cycles --------------------------------------------------------------------------
+
+# ECE-15 elementary urban cycle, UNECE Regulation No. 83, Annex 4a, Table 1: breakpoints of
+# (time [s], speed [km/h]); linear in between. 195 s, 0.994 km.
+_ECE15 = (
+    (0, 0),
+    (11, 0),
+    (15, 15),
+    (23, 15),
+    (25, 10),
+    (28, 0),
+    (49, 0),
+    (54, 15),
+    (56, 15),
+    (61, 32),
+    (85, 32),
+    (93, 10),
+    (96, 0),
+    (117, 0),
+    (122, 15),
+    (124, 15),
+    (133, 35),
+    (135, 35),
+    (143, 50),
+    (155, 50),
+    (163, 35),
+    (178, 35),
+    (185, 10),
+    (188, 0),
+    (195, 0),
+)
+# Extra-urban driving cycle (EUDC), same regulation, Annex 4a, Table 2. 400 s, 6.955 km.
+_EUDC = (
+    (0, 0),
+    (20, 0),
+    (25, 15),
+    (27, 15),
+    (36, 35),
+    (38, 35),
+    (46, 50),
+    (48, 50),
+    (61, 70),
+    (111, 70),
+    (119, 50),
+    (188, 50),
+    (201, 70),
+    (251, 70),
+    (286, 100),
+    (316, 100),
+    (336, 120),
+    (346, 120),
+    (362, 80),
+    (370, 50),
+    (380, 0),
+    (400, 0),
+)
+
+
+@dataclass(frozen=True)
+class DriveCycle:
+    """A speed trace at a fixed sampling interval.
+
+    Attributes
+    ----------
+    name
+        Where it came from.
+    dt_s
+        Sampling interval [s].
+    speed_mps
+        Speed samples [m/s].
+    grade
+        Road grade of each sample [–].
+    """
+
+    name: str
+    dt_s: float
+    speed_mps: FloatArray
+    grade: FloatArray
+
+    @property
+    def distance_m(self) -> float:
+        """Trapezoid distance [m]."""
+        return trace_distance_m(self.speed_mps, self.dt_s)
+
+    @property
+    def duration_s(self) -> float:
+        """Duration [s]."""
+        return (self.speed_mps.size - 1) * self.dt_s
+
+
+def _from_breakpoints(name: str, points: tuple[tuple[int, int], ...]) -> DriveCycle:
+    t, v = np.array(points, dtype=float).T
+    grid = np.arange(0.0, t[-1] + 1.0)
+    return DriveCycle(name, 1.0, np.interp(grid, t, v) * KMH, np.zeros(grid.size))
+
+
+def nedc() -> DriveCycle:
+    """The New European Driving Cycle at 1 Hz: 4 × ECE-15 then EUDC (1180 s, ≈ 10.93 km)."""
+    ece = _from_breakpoints("ECE-15", _ECE15).speed_mps
+    eudc = _from_breakpoints("EUDC", _EUDC).speed_mps
+    # Each part starts and ends at rest; drop the duplicated joint sample.
+    speed = np.concatenate([ece] + [ece[1:]] * 3 + [eudc[1:]])
+    return DriveCycle("NEDC", 1.0, speed, np.zeros(speed.size))
+
+
+# Column names of the time, speed and grade columns, by header style.
+_HEADER_STYLES = (
+    ("time_seconds", "speed_meters_per_second", "grade"),  # FASTSim 3
+    ("cycSecs", "cycMps", "cycGrade"),  # FASTSim 2
+    ("time_s", "speed_mps", "grade"),  # coldroute
+)
+
+
+def load_cycle_csv(path: str | Path) -> DriveCycle:
+    """Read a drive cycle from CSV: time [s], speed [m/s] and optionally grade [–].
+
+    Accepts the FASTSim-3 header (``time_seconds,speed_meters_per_second,grade``), the FASTSim-2
+    header (``cycSecs,cycMps,cycGrade,...``) and ``time_s,speed_mps,grade``; a UTF-8 BOM and CRLF
+    line ends are fine. Time must start anywhere, rise in equal steps; speed must be finite
+    and >= 0.
+    """
+    path = Path(path)
+    with path.open(newline="", encoding="utf-8-sig") as handle:
+        rows = list(csv.DictReader(handle))
+    if not rows:
+        raise InvalidParameterError(f"{path.name}: no data rows", "cycle")
+    header = set(rows[0])
+    for time_col, speed_col, grade_col in _HEADER_STYLES:  # noqa: B007 (used after break)
+        if {time_col, speed_col} <= header:
+            break
+    else:
+        raise InvalidParameterError(
+            f"{path.name}: unknown header {sorted(header)}; expected one of "
+            f"{[style[:2] for style in _HEADER_STYLES]}",
+            "cycle",
+        )
+    try:
+        time_s = np.array([float(r[time_col]) for r in rows])
+        speed = np.array([float(r[speed_col]) for r in rows])
+        grade = np.array([float(r.get(grade_col) or 0.0) for r in rows])
+    except ValueError as error:
+        raise InvalidParameterError(f"{path.name}: non-numeric value ({error})", "cycle") from None
+    steps = np.diff(time_s)
+    if steps.size == 0 or not np.all(np.isfinite(time_s)) or steps.min() <= 0:
+        raise InvalidParameterError(f"{path.name}: time must rise strictly", "cycle")
+    if np.ptp(steps) > 1e-6 * steps.mean():
+        raise InvalidParameterError(f"{path.name}: time steps must be equal", "cycle")
+    if not np.all(np.isfinite(speed)) or speed.min() < 0:
+        raise InvalidParameterError(f"{path.name}: speed must be finite and >= 0", "cycle")
+    return DriveCycle(path.stem, float(steps.mean()), speed, grade)

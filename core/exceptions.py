@@ -1,0 +1,40 @@
+"""Exceptions raised by the core, with messages a dispatcher understands.
+
+Every exception names the offending field (``field``, a dotted path) and the rule it broke, so
+that the web layer can turn it into a 4xx problem response without guessing.
+"""
+
+from __future__ import annotations
+
+
+class CoreError(ValueError):
+    """Base class of every error the core raises on bad input.
+
+    Parameters
+    ----------
+    message
+        Human-readable explanation naming the field and the rule.
+    field
+        Dotted path of the offending field (``"stops[3].lat"``), or ``None`` for a whole request.
+    """
+
+    def __init__(self, message: str, field: str | None = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.field = field
+
+
+class InvalidParameterError(CoreError):
+    """A parameter or input array breaks its documented rule (sign, range, finiteness...)."""
+
+
+class InvalidMatrixError(CoreError):
+    """A client-supplied distance or duration matrix is mis-sized or holds a bad entry."""
+
+
+class InvalidStopsError(CoreError):
+    """The stops of a round are empty, duplicated or otherwise unusable."""
+
+
+class LimitExceededError(CoreError):
+    """An input is larger than the configured limit (stops, samples...)."""

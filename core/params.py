@@ -1,0 +1,359 @@
+"""Parameter models: one definition of every parameter, with its unit, bounds and default.
+
+The models are frozen pydantic models so that the web layer reuses them directly: Swagger shows
+exactly what Python users see. Defaults are the paper's Table 1 where it gives a value; every
+other default is ours and its field description says where it comes from.
+
+Constructing a model directly from Python with a bad value raises
+:class:`core.exceptions.InvalidParameterError` naming the field and the rule. (When the web
+layer validates a request, pydantic's own error with the full field path is used instead.)
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal, Self
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from core.exceptions import InvalidParameterError
+
+#: Standard gravity [m/s²] (CGPM 1901).
+GRAVITY_MPS2 = 9.80665
+#: Duration of the New European Driving Cycle [s] (UNECE R83/R101), the paper's t_NEDC.
+NEDC_DURATION_S = 1180.0
+
+
+def describe_validation_error(error: ValidationError, prefix: str = "") -> str:
+    """One line per pydantic error: ``field.path: rule``."""
+    parts = []
+    for item in error.errors():
+        path = ".".join(str(p) for p in (prefix, *item["loc"]) if p != "")
+        parts.append(f"{path or 'input'}: {item['msg']}")
+    return "; ".join(parts)
+
+
+class Params(BaseModel):
+    """Base of every parameter model: frozen, no unknown fields, no NaN or infinity."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+    def __init__(self, **data: Any) -> None:
+        try:
+            super().__init__(**data)
+        except ValidationError as error:
+            first = error.errors()[0]["loc"]
+            raise InvalidParameterError(
+                describe_validation_error(error, type(self).__name__),
+                field=".".join(str(p) for p in first) or None,
+            ) from None
+
+
+class VehicleParams(Params):
+    """The van: longitudinal dynamics (paper §2.1) and the cab's consumers (§2.3)."""
+
+    mass_kg: float = Field(
+        1680.0, gt=0, le=40_000, description="Empty vehicle mass incl. driver [kg] (Table 1 m)."
+    )
+    drag_coefficient: float = Field(
+        0.329, gt=0, le=2, description="Aerodynamic drag coefficient c_d [–] (Table 1)."
+    )
+    frontal_area_m2: float = Field(
+        4.27, gt=0, le=20, description="Frontal area A_f [m²] (Table 1)."
+    )
+    rolling_resistance_coefficient: float = Field(
+        0.012, ge=0, le=0.1, description="Rolling-resistance coefficient c_r [–] (Table 1)."
+    )
+    rolling_resistance_factor: float = Field(
+        1.25,
+        gt=0,
+        le=3,
+        description="Factor on m·g·c_r in the rolling force [–]; 1.25 is the paper's eq. 4.",
+    )
+    drivetrain_efficiency: float = Field(
+        0.85,
+        gt=0,
+        le=1,
+        description="Battery-to-wheel efficiency when motoring η_el [–] (eq. 7); 0.85 is the "
+        "typical BEV figure NREL FASTSim uses.",
+    )
+    regen_efficiency: float = Field(
+        0.6,
+        ge=0,
+        le=1,
+        description="Share of braking power at the wheels returned to the battery [–]; "
+        "0 disables regeneration. 0.6 is a conservative van figure (FASTSim's Zoe: 0.773).",
+    )
+    max_regen_power_w: float | None = Field(
+        None, gt=0, le=1_000_000, description="Cap on regenerated electric power [W]; none if null."
+    )
+    max_acceleration_mps2: float = Field(
+        2.0,
+        gt=0,
+        le=10,
+        description="Maximum acceleration v̇_max [m/s²] (§2.2); 2.0 ≈ 0–100 km/h in 14 s.",
+    )
+    air_density_kg_m3: float = Field(
+        1.2, gt=0, le=2, description="Air density ρ for drag [kg/m³] (eq. 3); 1.2 at 20 °C."
+    )
+    auxiliaries_power_w: float = Field(
+        400.0,
+        ge=0,
+        le=20_000,
+        description="Constant auxiliaries (lights, radio, controls) [W]; 400 is the paper's §2.3.",
+    )
+    cabin_hvac_enabled: bool = Field(
+        True, description="Heat or cool the cab to 20 °C (paper Table 2); false switches it off."
+    )
+
+
+class CargoBoxParams(Params):
+    """The insulated cargo box and its refrigeration unit (paper §3)."""
+
+    volume_m3: float = Field(8.0, gt=0, le=100, description="Inner volume V [m³] (Table 1).")
+    wall_heat_transfer_w_m2k: float = Field(
+        2.172,
+        gt=0,
+        le=20,
+        description="Wall heat-transfer coefficient α [W/(m²·K)] (Table 1, eq. 11).",
+    )
+    roof_area_m2: float = Field(8.0, gt=0, le=100, description="Roof area A_r [m²] (Table 1).")
+    side_area_m2: float = Field(
+        4.182, gt=0, le=100, description="Area of one side wall A_s [m²] (Table 1)."
+    )
+    back_area_m2: float = Field(
+        3.12, gt=0, le=100, description="Back wall area A_b [m²] (Table 1)."
+    )
+    wall_area_m2: float | None = Field(
+        None,
+        gt=0,
+        le=500,
+        description="Total heat-transfer area A [m²] (eq. 11); null means 2·(A_r + A_s + A_b).",
+    )
+    setpoint_c: float = Field(
+        4.0, ge=-40, le=25, description="Cargo-air set-point ϑ_CB [°C]; 4 °C for chilled goods."
+    )
+    cop: float = Field(
+        1.5,
+        gt=0,
+        le=10,
+        description="Coefficient of performance of the refrigeration unit η_RU [–] (eq. 12); 1.5 "
+        "is typical of small electric units at 30 °C ambient, chilled box.",
+    )
+    solar_absorptivity: float = Field(
+        0.3,
+        ge=0,
+        le=1,
+        description="Solar absorptivity of the box's outer surface [–]; 0.3 for white paint.",
+    )
+    outside_film_coefficient_w_m2k: float = Field(
+        22.7,
+        gt=0,
+        le=200,
+        description="Outside surface film coefficient h_o [W/(m²·K)]: the share α/h_o of the "
+        "absorbed sun that crosses the wall (sol-air method, ASHRAE Fundamentals ch. 18).",
+    )
+    shadow_factor: float = Field(
+        0.8,
+        ge=0,
+        le=1,
+        description="Shadow factor b_sh [–] (eq. 17); 1 is full sun, 0.8 a partly shaded street.",
+    )
+    door_width_m: float = Field(1.2, gt=0, le=5, description="Door opening width W [m].")
+    door_height_m: float = Field(1.5, gt=0, le=5, description="Door opening height H [m].")
+    doorway_flow_factor: float = Field(
+        0.25,
+        gt=0,
+        le=1.5,
+        description="Doorway flow factor D_f [–] of the Gosney–Olama infiltration model, "
+        "calibrated so that 10 min open at 30 K costs about two hours of wall gain of an "
+        "ATP-class box (≈0.7 kWh; see core.cargo).",
+    )
+    curtain_effectiveness: float = Field(
+        0.0, ge=0, lt=1, description="Effectiveness E of a door curtain [–]; strips ≈ 0.9."
+    )
+    cargo_specific_heat_j_kgk: float = Field(
+        2300.0,
+        gt=0,
+        le=10_000,
+        description="Specific heat of the cargo c_p [J/(kg·K)] (Table 1: 2.3 kJ/(kg·K)).",
+    )
+    mode: Literal["steady", "dynamic"] = Field(
+        "steady",
+        description="'steady': the paper's assumption, box at set-point, unit covers every load. "
+        "'dynamic': box temperature integrated with a finite unit capacity.",
+    )
+    refrigeration_capacity_w: float = Field(
+        3000.0,
+        gt=0,
+        le=100_000,
+        description="Cooling capacity of the unit Q_0,max [W] (dynamic mode only).",
+    )
+    product_limit_c: float = Field(
+        7.0,
+        ge=-40,
+        le=40,
+        description="Highest cargo-air temperature the product tolerates [°C] (dynamic mode).",
+    )
+    heater_enabled: bool = Field(
+        False,
+        description="When the box loses heat (cold day), heat it electrically (efficiency 1) to "
+        "hold the set-point. The paper's van has no heater.",
+    )
+
+    @model_validator(mode="after")
+    def _limit_above_setpoint(self) -> Self:
+        if self.product_limit_c <= self.setpoint_c:
+            raise ValueError("product_limit_c must be above setpoint_c")
+        return self
+
+    @property
+    def heat_transfer_area_m2(self) -> float:
+        """Wall area A [m²] used in eq. 11."""
+        if self.wall_area_m2 is not None:
+            return self.wall_area_m2
+        return 2.0 * (self.roof_area_m2 + self.side_area_m2 + self.back_area_m2)
+
+
+class BatteryParams(Params):
+    """Traction battery as seen by the energy balance."""
+
+    usable_capacity_kwh: float = Field(
+        40.0, gt=0, le=2000, description="Usable battery capacity [kWh]."
+    )
+    initial_soc: float = Field(1.0, gt=0, le=1, description="State of charge at departure [–].")
+    min_soc: float = Field(
+        0.1, ge=0, lt=1, description="Reserve: lowest acceptable state of charge [–]."
+    )
+
+    @model_validator(mode="after")
+    def _reserve_below_start(self) -> Self:
+        if self.min_soc >= self.initial_soc:
+            raise ValueError("min_soc must be below initial_soc")
+        return self
+
+
+class Weather(Params):
+    """Daily extremes of the ambient temperature (paper §3.1)."""
+
+    t_min_c: float = Field(..., ge=-60, le=60, description="Lowest temperature of the day [°C].")
+    t_max_c: float = Field(..., ge=-60, le=60, description="Highest temperature of the day [°C].")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Self:
+        if self.t_min_c > self.t_max_c:
+            raise ValueError("t_min_c must not exceed t_max_c")
+        return self
+
+
+class Location(Params):
+    """A point on the Earth (WGS 84)."""
+
+    lat: float = Field(..., ge=-90, le=90, description="Latitude [°], north positive.")
+    lon: float = Field(..., ge=-180, le=180, description="Longitude [°], east positive.")
+
+
+class DoorOpening(Params):
+    """One opening of the cargo door during a simulated trace."""
+
+    start_s: float = Field(..., ge=0, description="Start, seconds after the trace start [s].")
+    duration_s: float = Field(..., ge=0, le=86_400, description="How long it stays open [s].")
+
+
+class StreetType(Params):
+    """Shape of the generated speed trace on one kind of street (paper §2.2)."""
+
+    mean_speed_mps: float = Field(..., gt=0, le=60, description="Mean speed v̄ [m/s].")
+    speed_variation: float = Field(
+        ..., ge=0, le=1, description="Relative amplitude dv of the trapezoid [–]."
+    )
+    period_divisor: float = Field(
+        ..., gt=0, le=1000, description="k in t_p = t_NEDC / k [–]: more k, shorter waves."
+    )
+    traffic_density: float = Field(
+        ..., gt=0, lt=1, description="Default traffic density ε_t on this street type [–]."
+    )
+
+
+#: Street-type presets. Mean speeds are typical free-flow averages (urban with lights,
+#: rural highway, motorway); the shape parameters are tuned so that a calm and an aggressive
+#: driver differ by the paper's 10–12 % on an urban leg (tests/core/test_cycles.py).
+STREET_TYPES: dict[str, StreetType] = {
+    "urban": StreetType(
+        mean_speed_mps=30 / 3.6, speed_variation=0.8, period_divisor=16, traffic_density=0.5
+    ),
+    "highway": StreetType(
+        mean_speed_mps=70 / 3.6, speed_variation=0.3, period_divisor=8, traffic_density=0.3
+    ),
+    "expressway": StreetType(
+        mean_speed_mps=100 / 3.6, speed_variation=0.15, period_divisor=4, traffic_density=0.2
+    ),
+}
+StreetTypeName = Literal["urban", "highway", "expressway"]
+
+#: Driver aggressiveness ε_d of a calm and of an aggressive driver (paper §2.2, Fig. 9).
+CALM_DRIVER = 0.2
+NORMAL_DRIVER = 0.5
+AGGRESSIVE_DRIVER = 1.0
+
+
+class VanParams(Params):
+    """Everything about the van that a simulation needs."""
+
+    vehicle: VehicleParams = Field(default_factory=VehicleParams)
+    cargo_box: CargoBoxParams = Field(default_factory=CargoBoxParams)
+    battery: BatteryParams = Field(default_factory=BatteryParams)
+    payload_kg: float = Field(
+        550.0, ge=0, le=40_000, description="Payload at departure [kg] (Table 1: 550 kg)."
+    )
+
+
+class Preset(VanParams):
+    """A named, complete set of van parameters."""
+
+    name: str = Field(..., description="Preset identifier.")
+    description: str = Field(..., description="What the preset represents and where it is from.")
+
+    def van(self) -> VanParams:
+        """The preset's parameters without its name and description."""
+        return VanParams(**{name: getattr(self, name) for name in VanParams.model_fields})
+
+
+PRESETS: dict[str, Preset] = {
+    "paper-generic": Preset(
+        name="paper-generic",
+        description="The paper's generic refrigerated e-van (Table 1: 1680 kg + 550 kg payload, "
+        "c_d 0.329, c_r 0.012, A_f 4.27 m², 8 m³ box, α 2.172 W/(m²·K)); a 40 kWh usable battery.",
+    ),
+    "reference-zoe": Preset(
+        name="reference-zoe",
+        description="NREL FASTSim's 2022 Renault Zoe ZE50 R135 as a longitudinal model (the "
+        "validation vehicle of shared/reference/cycles/REFERENCE.md): 1600 kg, c_d 0.33, "
+        "A_f 2.5122 m², c_r 0.009 with no 1.25 factor, regeneration 0.773, 52 kWh.",
+        vehicle=VehicleParams(
+            mass_kg=1600.0,
+            drag_coefficient=0.33,
+            frontal_area_m2=2.5122,
+            rolling_resistance_coefficient=0.009,
+            rolling_resistance_factor=1.0,
+            drivetrain_efficiency=0.85,
+            regen_efficiency=0.773,
+            air_density_kg_m3=1.2,
+            auxiliaries_power_w=250.0,
+            cabin_hvac_enabled=False,
+        ),
+        battery=BatteryParams(usable_capacity_kwh=52.0),
+        payload_kg=0.0,
+    ),
+}
+DEFAULT_PRESET = "paper-generic"
+
+
+def get_preset(name: str) -> Preset:
+    """The preset called ``name``; raises :class:`InvalidParameterError` if unknown."""
+    try:
+        return PRESETS[name]
+    except KeyError:
+        known = ", ".join(sorted(PRESETS))
+        raise InvalidParameterError(
+            f"unknown preset '{name}'; known presets: {known}", field="preset"
+        ) from None
