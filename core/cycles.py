@@ -40,16 +40,20 @@ def trace_distance_m(speed_mps: FloatArray, dt_s: float) -> float:
 
 
 def _wave_breakpoints(
-    street: StreetType, accel_mps2: float, traffic_density: float
+    street: StreetType, accel_mps2: float, traffic_density: float, leg_s: float
 ) -> tuple[FloatArray, FloatArray]:
-    """Times [s] and speeds [m/s] of one trapezoid wave plus its cruise, starting at ``v̄``."""
+    """Times [s] and speeds [m/s] of one trapezoid wave plus its cruise, starting at ``v̄``.
+
+    ``leg_s`` is the leg's duration at ``v̄``: cruising longer than that, or a wave that would
+    not fit in it (a nearly passive driver), makes the leg a constant-speed run.
+    """
     v_mean = street.mean_speed_mps
     v1 = v_mean * (1 - street.speed_variation)
     v2 = v_mean * (1 + street.speed_variation)
     period_s = NEDC_DURATION_S / street.period_divisor
     t_a = (v2 - v1) / accel_mps2 if accel_mps2 > 0 else math.inf
-    cruise_s = period_s * (1 - traffic_density) / traffic_density
-    if not math.isfinite(t_a) or v2 == v1:
+    cruise_s = min(period_s * (1 - traffic_density) / traffic_density, leg_s)
+    if 2 * t_a > leg_s or v2 == v1:
         return np.array([0.0, period_s + cruise_s]), np.array([v_mean, v_mean])
     # A driver too calm for the wave to fit in t_p stretches it (t_k = 0).
     t_k = max(period_s / 2 - t_a, 0.0)
@@ -97,7 +101,7 @@ def generate_leg(
     ramp_accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2
     v_mean = street.mean_speed_mps
 
-    wave_t, wave_v = _wave_breakpoints(street, accel, density)
+    wave_t, wave_v = _wave_breakpoints(street, accel, density, distance_m / v_mean)
     wave_length_m = v_mean * wave_t[-1]
     n_waves = int(distance_m // wave_length_m) + 2
     ramp_s = v_mean / ramp_accel
