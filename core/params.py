@@ -357,3 +357,45 @@ def get_preset(name: str) -> Preset:
         raise InvalidParameterError(
             f"unknown preset '{name}'; known presets: {known}", field="preset"
         ) from None
+
+
+class Depot(Params):
+    """Where the round starts and ends."""
+
+    id: str = Field("depot", min_length=1, max_length=64, description="Identifier of the depot.")
+    lat: float = Field(..., ge=-90, le=90, description="Latitude [°], north positive.")
+    lon: float = Field(..., ge=-180, le=180, description="Longitude [°], east positive.")
+    elevation_m: float | None = Field(
+        None, ge=-500, le=9000, description="Elevation above sea level [m]; gives leg grades."
+    )
+
+
+class Stop(Depot):
+    """A delivery stop."""
+
+    id: str = Field(..., min_length=1, max_length=64, description="Unique identifier of the stop.")
+    service_time_s: float = Field(300.0, ge=0, le=86_400, description="Time spent at the stop [s].")
+    door_open_s: float = Field(
+        60.0, ge=0, le=86_400, description="Time the cargo door is open, within the service [s]."
+    )
+    delivery_kg: float = Field(0.0, ge=0, le=40_000, description="Payload unloaded here [kg].")
+
+    @model_validator(mode="after")
+    def _door_within_service(self) -> Self:
+        if self.door_open_s > self.service_time_s:
+            raise ValueError("door_open_s must not exceed service_time_s")
+        return self
+
+
+class RoadMatrix(Params):
+    """Distances and durations from the client's road router: depot first, then the stops in
+    request order."""
+
+    distances_m: list[list[float]] = Field(..., description="Road distance of each pair [m].")
+    durations_s: list[list[float]] = Field(..., description="Driving time of each pair [s].")
+    street_types: list[list[StreetTypeName]] | None = Field(
+        None, description="Street type of each pair; null chooses by leg length."
+    )
+
+
+Objective = Literal["distance", "duration", "energy"]

@@ -1,0 +1,161 @@
+"""Legs between every ordered pair of places: distance, duration, street type and grade.
+
+Without a road router: great-circle distance times a detour factor, the street type by leg
+length and the duration from that street type's mean speed. A client may send its own road
+matrices instead; they are checked here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from core.arrays import FloatArray
+from core.exceptions import InvalidMatrixError
+from core.params import STREET_TYPES, Depot, RoadMatrix, StreetTypeName
+
+#: Mean Earth radius [m] (IUGG, Moritz 2000).
+EARTH_RADIUS_M = 6_371_008.8
+#: Road distance over great-circle distance. Circuity of road networks is 1.2–1.4 (Ballou,
+#: Rahardja & Sakai 2002, "Selected country circuity factors for road travel distance
+#: estimation"); 1.3 is their typical urban-regional value.
+DETOUR_FACTOR = 1.3
+#: Leg length [m] up to which a leg is urban, then highway up to the next bound, then expressway.
+URBAN_MAX_M = 5_000.0
+HIGHWAY_MAX_M = 25_000.0
+STREET_TYPE_NAMES: tuple[StreetTypeName, ...] = ("urban", "highway", "expressway")
+#: Steepest mean grade of a leg [–]; elevations that imply more are cut to it.
+MAX_LEG_GRADE = 0.25
+
+
+@dataclass(frozen=True)
+class Legs:
+    """Every ordered pair of places (index 0 the depot).
+
+    Attributes
+    ----------
+    distance_m, duration_s, grade
+        Road distance [m], driving time [s] and mean grade [–] of each pair.
+    street_type
+        Index into :data:`STREET_TYPE_NAMES` of each pair.
+    from_client
+        Whether distances and durations came from the client's road router.
+    """
+
+    distance_m: FloatArray
+    duration_s: FloatArray
+    grade: FloatArray
+    street_type: NDArray[np.int_]
+    from_client: bool
+
+    def street_type_name(self, i: int, j: int) -> StreetTypeName:
+        """Street type of the leg from ``i`` to ``j``."""
+        return STREET_TYPE_NAMES[int(self.street_type[i, j])]
+
+
+def great_circle_m(lat: FloatArray, lon: FloatArray) -> FloatArray:
+    """Great-circle distance of every pair of points [m] (haversine, mean Earth radius).
+
+    Parameters
+    ----------
+    lat, lon
+        Latitudes and longitudes [°].
+    """
+    phi, lam = np.radians(lat), np.radians(lon)
+    dphi = phi[:, None] - phi[None, :]
+    dlam = lam[:, None] - lam[None, :]
+    h = np.sin(dphi / 2) ** 2 + np.cos(phi)[:, None] * np.cos(phi)[None, :] * np.sin(dlam / 2) ** 2
+    return 2 * EARTH_RADIUS_M * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0)))
+
+
+def street_type_by_length(distance_m: FloatArray) -> NDArray[np.int_]:
+    """Street type index by leg length: urban up to 5 km, highway up to 25 km, else expressway.
+
+    Short hops between stops stay in town; longer legs reach the ring road or the motorway.
+    """
+    return np.searchsorted([URBAN_MAX_M, HIGHWAY_MAX_M], distance_m, side="left")
+
+
+def build_legs(places: Sequence[Depot], matrix: RoadMatrix | None = None) -> Legs:
+    """Distances, durations, street types and grades of every ordered pair of places.
+
+    Parameters
+    ----------
+    places
+        The depot first, then the stops.
+    matrix
+        The client's road matrices in the same order, or None for the built-in estimate.
+    """
+    n = len(places)
+    lat = np.array([p.lat for p in places])
+    lon = np.array([p.lon for p in places])
+    if matrix is None:
+        distance = great_circle_m(lat, lon) * DETOUR_FACTOR
+        street = street_type_by_length(distance)
+        speeds = np.array([STREET_TYPES[name].mean_speed_mps for name in STREET_TYPE_NAMES])
+        duration = distance / speeds[street]
+    else:
+        distance = _checked_matrix(matrix.distances_m, "distances_m", n)
+        duration = _checked_matrix(matrix.durations_s, "durations_s", n)
+        if matrix.street_types is None:
+            street = street_type_by_length(distance)
+        else:
+            _check_shape(matrix.street_types, "street_types", n)
+            street = np.array(
+                [[STREET_TYPE_NAMES.index(s) for s in row] for row in matrix.street_types]
+            )
+        positive = (distance > 0) & (duration == 0)
+        if positive.any():
+            i, j = (int(v) for v in np.argwhere(positive)[0])
+            raise InvalidMatrixError(
+                f"matrix.durations_s[{i}][{j}] is 0 for a leg of {distance[i, j]} m",
+                f"matrix.durations_s[{i}][{j}]",
+            )
+    elevation = np.array([p.elevation_m if p.elevation_m is not None else np.nan for p in places])
+    rise = elevation[None, :] - elevation[:, None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        grade = np.where(np.isfinite(rise) & (distance > 0), rise / distance, 0.0)
+    return Legs(
+        distance_m=distance,
+        duration_s=duration,
+        grade=np.clip(grade, -MAX_LEG_GRADE, MAX_LEG_GRADE),
+        street_type=street,
+        from_client=matrix is not None,
+    )
+
+
+def _check_shape(rows: Sequence[Sequence[object]], name: str, n: int) -> None:
+    if len(rows) != n:
+        raise InvalidMatrixError(
+            f"matrix.{name} has {len(rows)} rows; expected {n} (depot + {n - 1} stops)",
+            f"matrix.{name}",
+        )
+    for i, row in enumerate(rows):
+        if len(row) != n:
+            raise InvalidMatrixError(
+                f"matrix.{name}[{i}] has {len(row)} columns; expected {n}", f"matrix.{name}[{i}]"
+            )
+
+
+def _checked_matrix(rows: Sequence[Sequence[float]], name: str, n: int) -> FloatArray:
+    """A square, finite, non-negative matrix with a zero diagonal, or an error naming the cell."""
+    _check_shape(rows, name, n)
+    values = np.array(rows, dtype=float)
+    bad = ~np.isfinite(values) | (values < 0)
+    if bad.any():
+        i, j = (int(v) for v in np.argwhere(bad)[0])
+        raise InvalidMatrixError(
+            f"matrix.{name}[{i}][{j}] = {values[i, j]} must be finite and >= 0",
+            f"matrix.{name}[{i}][{j}]",
+        )
+    diagonal = np.flatnonzero(np.diag(values) != 0)
+    if diagonal.size:
+        i = int(diagonal[0])
+        raise InvalidMatrixError(
+            f"matrix.{name}[{i}][{i}] = {values[i, i]}: the diagonal must be 0",
+            f"matrix.{name}[{i}][{i}]",
+        )
+    return values
