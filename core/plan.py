@@ -10,6 +10,7 @@ split per leg and per stop.
 from __future__ import annotations
 
 import datetime as dt
+import itertools
 import math
 from dataclasses import dataclass
 from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
@@ -18,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
+from core.arrays import FloatArray
 from core.battery import JOULES_PER_KWH, BatteryVerdict
 from core.cycles import generate_leg, stretch_to_duration, trace_distance_m
 from core.exceptions import InvalidParameterError, InvalidStopsError
@@ -128,12 +130,10 @@ def plan(problem: PlanProblem) -> PlanResult:
     start, timezone_name = _departure(problem)
     places: list[Depot] = [problem.depot, *problem.stops]
     legs = build_legs(places, problem.matrix)
-    cost, unit_value = _cost_matrix(problem, legs, start)
+    cost, unit_value, offset = _cost_matrix(problem, legs, start)
     tour = solve_tour(cost, problem.time_limit_s, problem.keep_order)
     order = tour.order
-    objective_value = float(cost[order[:-1], order[1:]].sum()) * unit_value + _cost_offset(
-        problem, legs, start
-    ) * (len(order) - 1)
+    objective_value = tour.cost * unit_value + offset * (len(order) - 1)
 
     speed, grade, payload, doors, marks = _timeline(problem, legs, order)
     result = simulate(
@@ -215,7 +215,7 @@ def _constant_power_w(problem: PlanProblem, start: dt.datetime) -> float:
     return float(sum(standing.power_w[name][0] for name in CONSUMERS if name != "traction"))
 
 
-def _energy_matrix_j(problem: PlanProblem, legs: Legs, start: dt.datetime) -> NDArray[np.float64]:
+def _energy_matrix_j(problem: PlanProblem, legs: Legs, start: dt.datetime) -> FloatArray:
     """Estimated electric energy of every leg [J]: the energy objective's arc costs.
 
     Traction per metre on flat ground comes from one simulated 10 km reference leg per street
@@ -248,30 +248,23 @@ def _energy_matrix_j(problem: PlanProblem, legs: Legs, start: dt.datetime) -> ND
 
 def _cost_matrix(
     problem: PlanProblem, legs: Legs, start: dt.datetime
-) -> tuple[NDArray[np.int64], float]:
-    """Integer arc costs for the solver and the value of one cost unit in the objective's unit.
+) -> tuple[NDArray[np.int64], float, float]:
+    """Integer arc costs for the solver, the value of one cost unit and a per-arc offset, both in
+    the objective's unit (m, s or Wh).
 
     Distance in metres and duration in seconds, rounded to the nearest integer; energy in
     tenths of a watt-hour, shifted so the cheapest arc costs 0 (every tour has the same number
-    of arcs, so the shift does not change the best tour; :func:`_cost_offset` adds it back).
+    of arcs, so the shift does not change the best tour; the offset adds it back).
     """
     if problem.objective == "distance":
-        return np.rint(legs.distance_m).astype(np.int64), 1.0
+        return np.rint(legs.distance_m).astype(np.int64), 1.0, 0.0
     if problem.objective == "duration":
-        return np.rint(legs.duration_s).astype(np.int64), 1.0
+        return np.rint(legs.duration_s).astype(np.int64), 1.0, 0.0
     tenth_wh = _energy_matrix_j(problem, legs, start) / 360.0
     off_diagonal = ~np.eye(tenth_wh.shape[0], dtype=bool)
-    shifted = tenth_wh - tenth_wh[off_diagonal].min() if off_diagonal.any() else tenth_wh
-    return np.rint(np.where(off_diagonal, shifted, 0.0)).astype(np.int64), 0.1
-
-
-def _cost_offset(problem: PlanProblem, legs: Legs, start: dt.datetime) -> float:
-    """Per-arc shift taken out of the energy costs [Wh]; 0 for the other objectives."""
-    if problem.objective != "energy" or legs.distance_m.shape[0] < 2:
-        return 0.0
-    tenth_wh = _energy_matrix_j(problem, legs, start) / 360.0
-    off_diagonal = ~np.eye(tenth_wh.shape[0], dtype=bool)
-    return float(tenth_wh[off_diagonal].min()) * 0.1
+    lowest = float(tenth_wh[off_diagonal].min()) if off_diagonal.any() else 0.0
+    shifted = np.where(off_diagonal, tenth_wh - lowest, 0.0)
+    return np.rint(shifted).astype(np.int64), 0.1, lowest * 0.1
 
 
 @dataclass(frozen=True)
@@ -286,19 +279,17 @@ class _Marks:
 
 def _timeline(
     problem: PlanProblem, legs: Legs, order: list[int]
-) -> tuple[
-    NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], list[DoorOpening], _Marks
-]:
+) -> tuple[FloatArray, FloatArray, FloatArray, list[DoorOpening], _Marks]:
     """Speed, grade and payload of every sample of the day, the door openings and the marks."""
     vehicle = problem.van.vehicle
-    speed_parts: list[NDArray[np.float64]] = [np.zeros(1)]
-    grade_parts: list[NDArray[np.float64]] = [np.zeros(1)]
-    payload_parts: list[NDArray[np.float64]] = [np.array([problem.van.payload_kg])]
+    speed_parts: list[FloatArray] = [np.zeros(1)]
+    grade_parts: list[FloatArray] = [np.zeros(1)]
+    payload_parts: list[FloatArray] = [np.array([problem.van.payload_kg])]
     doors: list[DoorOpening] = []
     depart, arrive, leave = [], [], []
     clock = 0
     payload = problem.van.payload_kg
-    for i, j in zip(order[:-1], order[1:], strict=True):
+    for i, j in itertools.pairwise(order):
         trace = generate_leg(
             float(legs.distance_m[i, j]),
             STREET_TYPES[legs.street_type_name(i, j)],
@@ -338,7 +329,7 @@ def _timeline(
     )
 
 
-def _span_kwh(cumulative_j: dict[str, NDArray[np.float64]], a: int, b: int) -> dict[str, float]:
+def _span_kwh(cumulative_j: dict[str, FloatArray], a: int, b: int) -> dict[str, float]:
     """Energy per consumer and total between samples a and b [kWh]."""
     energy = {name: float(c[b] - c[a]) / JOULES_PER_KWH for name, c in cumulative_j.items()}
     energy["total"] = sum(energy.values())
@@ -370,7 +361,7 @@ def _assemble(
 
     leg_results, stop_results = [], []
     payload = problem.van.payload_kg
-    for k, (i, j) in enumerate(zip(order[:-1], order[1:], strict=True)):
+    for k, (i, j) in enumerate(itertools.pairwise(order)):
         a, b, c = int(marks.depart[k]), int(marks.arrive[k]), int(marks.leave[k])
         leg_results.append(
             LegResult(

@@ -3,7 +3,8 @@
 Small rounds are solved exactly with CP-SAT's circuit constraint, which proves optimality;
 larger rounds with the OR-Tools routing library: a Christofides start, then guided local search
 with the multi-armed-bandit operator schedule and only the operators that apply to one route
-(measured best of the routing options on shared/reference/tsplib at 1 s; benchmarks/). Costs are non-negative integers: the caller rounds explicitly (metres, seconds, Wh).
+(measured best of the routing options on shared/reference/tsplib at 1 s; benchmarks/).
+Costs are non-negative integers: the caller rounds explicitly (metres, seconds, Wh).
 """
 
 from __future__ import annotations
