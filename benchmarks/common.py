@@ -6,6 +6,8 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+import numpy as np
+
 REFERENCE = Path(__file__).resolve().parents[1].parent / "shared" / "reference"
 
 
@@ -27,3 +29,18 @@ def print_table(title: str, header: Sequence[str], rows: Sequence[Sequence[objec
     print("|" + "|".join("---" for _ in header) + "|")
     for row in rows:
         print("| " + " | ".join(str(cell) for cell in row) + " |")
+
+
+def euc_2d_matrix(path: Path) -> np.ndarray:
+    """Integer distance matrix of a TSPLIB EUC_2D instance: nint(euclidean distance)."""
+    lines = path.read_text().splitlines()
+    start = lines.index("NODE_COORD_SECTION") + 1
+    points = []
+    for line in lines[start:]:
+        if line.strip() in ("EOF", ""):
+            break
+        _, x, y = line.split()[:3]
+        points.append((float(x), float(y)))
+    xy = np.array(points)
+    distance = np.sqrt(((xy[:, None, :] - xy[None, :, :]) ** 2).sum(axis=-1))
+    return np.floor(distance + 0.5).astype(np.int64)

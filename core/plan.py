@@ -23,7 +23,7 @@ from core.arrays import FloatArray
 from core.battery import JOULES_PER_KWH, BatteryVerdict
 from core.cycles import generate_leg, stretch_to_duration, trace_distance_m
 from core.exceptions import InvalidParameterError, InvalidStopsError
-from core.geo import STREET_TYPE_NAMES, Legs, build_legs
+from core.geo import MAX_LEG_GRADE, STREET_TYPE_NAMES, Legs, build_legs
 from core.params import (
     NORMAL_DRIVER,
     STREET_TYPES,
@@ -218,15 +218,17 @@ def _constant_power_w(problem: PlanProblem, start: dt.datetime) -> float:
 def _energy_matrix_j(problem: PlanProblem, legs: Legs, start: dt.datetime) -> FloatArray:
     """Estimated electric energy of every leg [J]: the energy objective's arc costs.
 
-    Traction per metre on flat ground comes from one simulated 10 km reference leg per street
-    type (same driver, traffic and departure mass); the climb ``m·g·Δh`` is added over the
-    drive-train efficiency uphill and times the regeneration efficiency downhill, which makes
-    the matrix asymmetric; auxiliaries, cab and box add their power at departure times the
-    leg's duration. The chosen tour is then simulated in full.
+    Traction per metre is simulated once per street type on a 10 km reference trace (same
+    driver, traffic and departure mass) at every grade of a table from −25 % to +25 % in one
+    broadcast call, and read for each leg by interpolation in its grade: climbs cost over the
+    drive-train efficiency, descents first replace motoring and only then regenerate, and the
+    matrix is asymmetric. Auxiliaries, cab and box add their power at departure times the leg's
+    duration. The chosen tour is then simulated in full.
     """
     vehicle = problem.van.vehicle
     mass = vehicle.mass_kg + problem.van.payload_kg
-    per_metre = np.empty(len(STREET_TYPE_NAMES))
+    grades = np.linspace(-MAX_LEG_GRADE, MAX_LEG_GRADE, 51)
+    traction = np.zeros_like(legs.distance_m)
     for index, name in enumerate(STREET_TYPE_NAMES):
         trace = generate_leg(
             _REFERENCE_LEG_M,
@@ -236,13 +238,11 @@ def _energy_matrix_j(problem: PlanProblem, legs: Legs, start: dt.datetime) -> Fl
             problem.traffic_density,
             PLAN_DT_S,
         )
-        power = step_traction_power_w(vehicle, trace, PLAN_DT_S, mass, 0.0)
-        per_metre[index] = power.sum() * PLAN_DT_S / _REFERENCE_LEG_M
-    climb = mass * 9.80665 * legs.grade / np.sqrt(1 + legs.grade**2) * legs.distance_m
-    climb = np.where(
-        climb > 0, climb / vehicle.drivetrain_efficiency, climb * vehicle.regen_efficiency
-    )
-    traction = per_metre[legs.street_type] * legs.distance_m + climb
+        power = step_traction_power_w(vehicle, trace, PLAN_DT_S, mass, grades[:, None])
+        per_metre = power.sum(axis=1) * PLAN_DT_S / _REFERENCE_LEG_M
+        on_type = legs.street_type == index
+        traction[on_type] = np.interp(legs.grade[on_type], grades, per_metre)
+    traction *= legs.distance_m
     return traction + _constant_power_w(problem, start) * legs.duration_s
 
 
