@@ -11,6 +11,9 @@ layer validates a request, pydantic's own error with the full field path is used
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any, Literal, Self
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -32,14 +35,32 @@ def describe_validation_error(error: ValidationError, prefix: str = "") -> str:
     return "; ".join(parts)
 
 
+_INSIDE_VALIDATION: ContextVar[bool] = ContextVar("coldroute_inside_validation", default=False)
+
+
+@contextmanager
+def inside_validation() -> Iterator[None]:
+    """Mark a larger model's validation: nested parameter models then keep pydantic's own
+    error, with its full field path, for the outer model to report."""
+    token = _INSIDE_VALIDATION.set(True)
+    try:
+        yield
+    finally:
+        _INSIDE_VALIDATION.reset(token)
+
+
 class Params(BaseModel):
     """Base of every parameter model: frozen, no unknown fields, no NaN or infinity."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
     def __init__(self, **data: Any) -> None:
-        try:
+        if _INSIDE_VALIDATION.get():
             super().__init__(**data)
+            return
+        try:
+            with inside_validation():
+                super().__init__(**data)
         except ValidationError as error:
             first = error.errors()[0]["loc"]
             raise InvalidParameterError(

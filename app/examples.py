@@ -1,0 +1,62 @@
+"""Realistic request examples shown in Swagger UI; the tests send them as they are."""
+
+from __future__ import annotations
+
+from typing import Any
+
+# A morning round in Vienna: depot in Simmering, eight grocery and pharmacy stops.
+_VIENNA_STOPS = [
+    ("billa-landstrasse", 48.2006, 16.3862, 120, 30),
+    ("spar-wieden", 48.1925, 16.3671, 60, 25),
+    ("apotheke-margareten", 48.1878, 16.3553, 40, 10),
+    ("merkur-mariahilf", 48.1967, 16.3446, 80, 45),
+    ("hofer-neubau", 48.2036, 16.3489, 60, 35),
+    ("bio-josefstadt", 48.2108, 16.3485, 40, 20),
+    ("cafe-innere-stadt", 48.2097, 16.3702, 60, 15),
+    ("billa-leopoldstadt", 48.2186, 16.3921, 60, 30),
+]
+
+PLAN_EXAMPLE: dict[str, Any] = {
+    "date": "2026-07-15",
+    "start_time": "09:00",
+    "timezone": "Europe/Vienna",
+    "depot": {"id": "depot-simmering", "lat": 48.1703, "lon": 16.4207, "elevation_m": 160},
+    "stops": [
+        {
+            "id": stop_id,
+            "lat": lat,
+            "lon": lon,
+            "service_time_s": service_s,
+            "door_open_s": service_s // 2,
+            "delivery_kg": delivery_kg,
+        }
+        for stop_id, lat, lon, service_s, delivery_kg in (
+            (s[0], s[1], s[2], 300 + 2 * s[3], s[4]) for s in _VIENNA_STOPS
+        )
+    ],
+    "vehicle": {"preset": "paper-generic"},
+    "payload_kg": 550,
+    "battery": {"usable_capacity_kwh": 40, "initial_soc": 0.95, "min_soc": 0.15},
+    "weather": {"t_min_c": 18, "t_max_c": 31},
+    "driver_aggressiveness": 0.5,
+    "objective": "energy",
+}
+
+SIMULATE_EXAMPLE: dict[str, Any] = {
+    "cycle": {"street_type": "urban", "distance_m": 8000, "driver_aggressiveness": 0.5},
+    "start": "2026-07-15T11:00:00+02:00",
+    "location": {"lat": 48.21, "lon": 16.37},
+    "vehicle": {"preset": "paper-generic"},
+    "weather": {"t_min_c": 18, "t_max_c": 31},
+    "door_openings": [{"start_s": 300, "duration_s": 90}],
+}
+
+SIMULATE_TRACE_EXAMPLE: dict[str, Any] = {
+    "speed_mps": [0, 2, 4, 6, 8, 8, 8, 6, 3, 0],
+    "dt_s": 1,
+    "grade": 0.02,
+    "start": "2026-01-20T08:30:00+01:00",
+    "location": {"lat": 48.21, "lon": 16.37},
+    "vehicle": {"preset": "paper-generic", "mass_kg": 1900},
+    "include_series": True,
+}

@@ -1,0 +1,161 @@
+"""The coldroute web service: ``create_app()`` wires routers, middleware and error handlers."""
+
+from __future__ import annotations
+
+import json
+import logging
+import secrets
+import time
+from importlib.metadata import version
+from typing import Annotated
+
+from fastapi import APIRouter, Depends, FastAPI, Header, HTTPException
+from fastapi.middleware.cors import CORSMiddleware
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from app import errors
+from app.routers import health, plans, presets, simulate
+from app.settings import Settings, get_settings
+
+_log = logging.getLogger("coldroute.requests")
+
+DESCRIPTION = """
+Route planning and energy simulation for **all-electric refrigerated delivery vans**.
+
+`POST /v1/plans` orders a round's stops with OR-Tools, simulates every leg with the
+drive-train, cab and refrigeration model of *"Wholistic simulation of an all-electric
+refrigerated delivery vehicle"* and says whether the battery holds out with its reserve.
+`POST /v1/simulate` gives the energy of one speed trace. Units are in the field names
+(`_m`, `_s`, `_kwh`, `_c`...). Errors are `application/problem+json` (RFC 9457).
+"""
+
+
+class BodyLimit:
+    """Answer 413 to a request body larger than ``max_bytes`` (declared or streamed)."""
+
+    def __init__(self, app: ASGIApp, max_bytes: int) -> None:
+        self.app = app
+        self.max_bytes = max_bytes
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        declared = dict(scope["headers"]).get(b"content-length")
+        if declared is not None and declared.isdigit() and int(declared) > self.max_bytes:
+            await self._reject(send)
+            return
+        received = 0
+
+        async def counting_receive() -> Message:
+            nonlocal received
+            message = await receive()
+            received += len(message.get("body", b""))
+            if received > self.max_bytes:
+                raise HTTPException(413, f"request body exceeds {self.max_bytes} bytes")
+            return message
+
+        await self.app(scope, counting_receive, send)
+
+    async def _reject(self, send: Send) -> None:
+        body = json.dumps(
+            {
+                "type": "/problems/request-too-large",
+                "title": "Request too large",
+                "status": 413,
+                "detail": f"request body exceeds {self.max_bytes} bytes",
+            }
+        ).encode()
+        await send(
+            {
+                "type": "http.response.start",
+                "status": 413,
+                "headers": [
+                    (b"content-type", errors.PROBLEM_JSON.encode()),
+                    (b"content-length", str(len(body)).encode()),
+                ],
+            }
+        )
+        await send({"type": "http.response.body", "body": body})
+
+
+class RequestLog:
+    """One structured (JSON) log line per request: method, path, status, duration."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        started = time.perf_counter()
+        status = 500
+
+        async def recording_send(message: Message) -> None:
+            nonlocal status
+            if message["type"] == "http.response.start":
+                status = message["status"]
+            await send(message)
+
+        try:
+            await self.app(scope, receive, recording_send)
+        finally:
+            _log.info(
+                json.dumps(
+                    {
+                        "method": scope["method"],
+                        "path": scope["path"],
+                        "status": status,
+                        "duration_ms": round((time.perf_counter() - started) * 1000, 1),
+                    }
+                )
+            )
+
+
+def require_api_key(
+    settings: Annotated[Settings, Depends(get_settings)],
+    x_api_key: Annotated[
+        str | None, Header(description="Needed when the server sets a key.")
+    ] = None,
+) -> None:
+    """401 unless the request carries the configured key (no key configured: open)."""
+    if settings.api_key is None:
+        return
+    expected = settings.api_key.get_secret_value()
+    if x_api_key is None or not secrets.compare_digest(x_api_key, expected):
+        raise HTTPException(
+            401, "missing or wrong X-API-Key", headers={"WWW-Authenticate": "ApiKey"}
+        )
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    """The ASGI application; ``settings`` overrides the environment (tests)."""
+    settings = settings or get_settings()
+    logging.basicConfig(level=settings.log_level.upper(), format="%(message)s")
+    app = FastAPI(
+        title="coldroute",
+        version=version("coldroute"),
+        description=DESCRIPTION,
+        responses={422: {"description": "Invalid request (problem+json)"}},
+    )
+    app.dependency_overrides[get_settings] = lambda: settings
+    errors.install(app)
+    v1 = APIRouter(prefix="/v1", dependencies=[Depends(require_api_key)])
+    for module in (plans, simulate, presets):
+        v1.include_router(module.router)
+    app.include_router(v1)
+    app.include_router(health.router)
+    if settings.cors_origins:
+        app.add_middleware(
+            CORSMiddleware,
+            allow_origins=settings.cors_origins,
+            allow_methods=["*"],
+            allow_headers=["*"],
+        )
+    app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
+    app.add_middleware(RequestLog)
+    return app
+
+
+app = create_app()

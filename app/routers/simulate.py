@@ -1,0 +1,95 @@
+"""POST /v1/simulate: energy of one speed trace."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import numpy as np
+from fastapi import APIRouter, Body, Depends
+
+from app.examples import SIMULATE_EXAMPLE, SIMULATE_TRACE_EXAMPLE
+from app.routers import results
+from app.schemas import ConsumptionWhPerKm, PowerSeries, Series, SimulateRequest, SimulateResponse
+from app.settings import Settings, get_settings
+from core.cycles import generate_leg
+from core.exceptions import LimitExceededError
+from core.params import STREET_TYPES
+from core.simulate import simulate
+
+router = APIRouter(tags=["simulation"])
+
+
+@router.post("/simulate", operation_id="simulateTrace", summary="Energy of one speed trace")
+def simulate_trace(
+    request: Annotated[
+        SimulateRequest,
+        Body(
+            openapi_examples={
+                "urban-cycle": {
+                    "summary": "Generated 8 km urban leg, summer",
+                    "value": SIMULATE_EXAMPLE,
+                },
+                "own-trace": {
+                    "summary": "Your own 1 Hz trace, winter, with series",
+                    "value": SIMULATE_TRACE_EXAMPLE,
+                },
+            }
+        ),
+    ],
+    settings: Annotated[Settings, Depends(get_settings)],
+) -> SimulateResponse:
+    """Per-consumer power and energy, state of charge and battery verdict along a trace you send
+    (`speed_mps`, `dt_s`, `grade`) or one generated from a street type (`cycle`)."""
+    van = request.van()
+    if request.cycle is not None:
+        cycle = request.cycle
+        speed = generate_leg(
+            cycle.distance_m,
+            STREET_TYPES[cycle.street_type],
+            cycle.driver_aggressiveness,
+            van.vehicle.max_acceleration_mps2,
+            cycle.traffic_density,
+            request.dt_s,
+        )
+    else:
+        speed = np.asarray(request.speed_mps, dtype=float)
+    if speed.size > settings.max_trace_samples:
+        raise LimitExceededError(
+            f"the trace has {speed.size} samples; this server simulates at most "
+            f"{settings.max_trace_samples}",
+            "speed_mps" if request.cycle is None else "cycle.distance_m",
+        )
+    result = simulate(
+        speed,
+        request.dt_s,
+        request.start,
+        request.location,
+        van,
+        grade=request.grade,
+        weather=request.weather,
+        door_openings=request.door_openings,
+    )
+    km = result.distance_m / 1000
+    per_km = {k: (v * 1000 / km if km > 0 else None) for k, v in result.energy_kwh.items()}
+    series = None
+    if request.include_series:
+        series = Series(
+            time_s=result.time_s.tolist(),
+            speed_mps=result.speed_mps.tolist(),
+            power_w=PowerSeries(**{k: [0.0, *p.tolist()] for k, p in result.power_w.items()}),
+            soc=result.soc.tolist(),
+        )
+    dynamic = van.cargo_box.mode == "dynamic"
+    return SimulateResponse(
+        distance_m=result.distance_m,
+        duration_s=result.duration_s,
+        energy_kwh=results.energy(result.energy_kwh),
+        consumption_wh_per_km=ConsumptionWhPerKm(**per_km),
+        battery=results.battery(result.battery, None),
+        weather=results.weather(result.weather, result.weather_source),
+        box=results.box(
+            result.box.max_temperature_c if dynamic else None,
+            result.box.minutes_above_limit if dynamic else None,
+        ),
+        series=series,
+    )

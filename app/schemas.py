@@ -1,0 +1,358 @@
+"""Request and response models of the HTTP API. Parameters reuse the core's definitions."""
+
+from __future__ import annotations
+
+import datetime as dt
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, Self
+
+from pydantic import (
+    AwareDatetime,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ModelWrapValidatorHandler,
+    create_model,
+    model_validator,
+)
+
+from core.exceptions import InvalidParameterError
+from core.params import (
+    DEFAULT_PRESET,
+    NORMAL_DRIVER,
+    BatteryParams,
+    CargoBoxParams,
+    Depot,
+    DoorOpening,
+    Location,
+    Objective,
+    Params,
+    Preset,
+    RoadMatrix,
+    Stop,
+    StreetTypeName,
+    VanParams,
+    VehicleParams,
+    Weather,
+    get_preset,
+    inside_validation,
+)
+from core.tsp import SolverStatus
+from core.weather import WeatherSource
+
+
+class ApiModel(BaseModel):
+    """Base of the API's own models: no unknown fields, no NaN or infinity."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _keep_field_paths(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
+        # Nested core parameter models report pydantic's errors with their full path.
+        with inside_validation():
+            return handler(data)
+
+
+def _overrides(name: str, params: type[Params], doc: str, **extra: Any) -> type[ApiModel]:
+    """A model with every field of ``params`` optional: the values to change in a preset.
+
+    Each field keeps the core's type, bounds and description, so Swagger shows exactly the
+    parameter the core uses.
+    """
+    fields: dict[str, Any] = dict(extra)
+    for field_name, info in params.model_fields.items():
+        default = info.get_default(call_default_factory=True)
+        annotation: Any = (
+            Annotated[(info.annotation, *info.metadata)] if info.metadata else info.annotation
+        )
+        fields[field_name] = (
+            Optional[annotation],  # noqa: UP045 (a run-time type, not an annotation)
+            Field(
+                None,
+                description=f"{info.description} Preset value if absent "
+                f"(paper-generic: {default}).",
+            ),
+        )
+    return create_model(name, __base__=ApiModel, __doc__=doc, **fields)
+
+
+if TYPE_CHECKING:  # the request models are built at run time from the core's parameters
+    VehicleRequest = ApiModel
+    CargoBoxRequest = ApiModel
+    BatteryRequest = ApiModel
+else:
+    VehicleRequest = _overrides(
+        "VehicleRequest",
+        VehicleParams,
+        "The van: a preset and any parameter to change in it.",
+        preset=(str, Field(DEFAULT_PRESET, description="Preset name (GET /v1/presets).")),
+    )
+    CargoBoxRequest = _overrides(
+        "CargoBoxRequest",
+        CargoBoxParams,
+        "Cargo box and refrigeration unit: changes to the preset.",
+    )
+    BatteryRequest = _overrides("BatteryRequest", BatteryParams, "Battery: changes to the preset.")
+
+
+class VanRequest(ApiModel):
+    """The parts of a request that describe the van (shared by plans, simulation, studies)."""
+
+    vehicle: VehicleRequest = Field(default_factory=VehicleRequest)
+    cargo_box: CargoBoxRequest = Field(default_factory=CargoBoxRequest)
+    battery: BatteryRequest = Field(default_factory=BatteryRequest)
+    payload_kg: float | None = Field(
+        None, ge=0, le=40_000, description="Payload at departure [kg]; preset value if absent."
+    )
+
+    def van(self) -> VanParams:
+        """The preset with this request's changes applied, validated by the core models; an
+        error names the request section (``cargo_box.setpoint_c``)."""
+        preset: Preset = get_preset(getattr(self.vehicle, "preset"))  # noqa: B009
+        sections = {
+            "vehicle": (VehicleParams, preset.vehicle),
+            "cargo_box": (CargoBoxParams, preset.cargo_box),
+            "battery": (BatteryParams, preset.battery),
+        }
+        built: dict[str, Any] = {}
+        for section, (model, base) in sections.items():
+            changes: ApiModel = getattr(self, section)
+            wanted = {k: getattr(changes, k) for k in changes.model_fields_set if k != "preset"}
+            try:
+                built[section] = model(**(base.model_dump() | wanted))
+            except InvalidParameterError as error:
+                message = error.message.replace(model.__name__, section, 1)
+                field = f"{section}.{error.field}" if error.field else section
+                raise InvalidParameterError(message, field) from None
+        payload = preset.payload_kg if self.payload_kg is None else self.payload_kg
+        return VanParams(**built, payload_kg=payload)
+
+
+class PlanRequest(VanRequest):
+    """A delivery round to plan: depot, stops, date, van and conditions."""
+
+    date: dt.date = Field(..., description="Day of the round, YYYY-MM-DD.")
+    start_time: str = Field(
+        "08:00", pattern=r"^([01]\d|2[0-3]):[0-5]\d$", description="Departure, local HH:MM."
+    )
+    timezone: str | None = Field(
+        None,
+        max_length=64,
+        description="IANA time zone (Europe/Vienna); absent: local mean solar time at the depot.",
+    )
+    depot: Depot
+    stops: list[Stop] = Field(..., min_length=1, description="The stops, in any order.")
+    weather: Weather | None = Field(
+        None, description="The day's forecast; absent: the climatology for date and latitude."
+    )
+    driver_aggressiveness: float = Field(
+        NORMAL_DRIVER, ge=0, le=1, description="ε_d [–]: 0.2 calm, 0.5 normal, 1 aggressive."
+    )
+    traffic_density: float | None = Field(
+        None, gt=0, lt=1, description="ε_t [–]; absent: the street type's default."
+    )
+    objective: Objective = Field("distance", description="What the tour minimises.")
+    matrix: RoadMatrix | None = Field(
+        None, description="Road distances/durations from your router: depot first, then stops."
+    )
+    keep_order: bool = Field(False, description="Drive the stops in the given order.")
+    time_limit_s: float = Field(
+        1.0, gt=0, le=600, description="Solver budget [s], capped by the server's setting."
+    )
+
+
+class EnergyKwh(ApiModel):
+    """Electric energy per consumer [kWh]."""
+
+    traction: float = Field(..., description="Drive train, net of regeneration [kWh].")
+    auxiliaries: float = Field(..., description="Lights, radio, controls [kWh].")
+    cabin: float = Field(..., description="Cab heating / air conditioning [kWh].")
+    refrigeration: float = Field(..., description="Refrigeration unit and box heater [kWh].")
+    total: float = Field(..., description="Sum of the consumers [kWh].")
+
+
+class EnergyShare(ApiModel):
+    """Each consumer's share of the total energy [–]."""
+
+    traction: float
+    auxiliaries: float
+    cabin: float
+    refrigeration: float
+
+
+class LegOut(ApiModel):
+    """One driven leg."""
+
+    from_id: str
+    to_id: str
+    depart: dt.datetime = Field(..., description="Departure, local time with offset.")
+    arrive: dt.datetime = Field(..., description="Arrival, local time with offset.")
+    distance_m: float = Field(..., description="Distance [m].")
+    duration_s: float = Field(..., description="Driving time [s].")
+    street_type: StreetTypeName
+    grade: float = Field(..., description="Mean grade, rise over run [–].")
+    energy_kwh: EnergyKwh
+    soc_start: float = Field(..., description="State of charge at departure [–].")
+    soc_end: float = Field(..., description="State of charge on arrival [–].")
+
+
+class StopOut(ApiModel):
+    """One stop, in visiting order."""
+
+    id: str
+    arrival: dt.datetime
+    departure: dt.datetime
+    door_heat_kwh: float = Field(..., description="Heat let in through the open door [kWh].")
+    payload_after_kg: float = Field(..., description="Payload when leaving the stop [kg].")
+    energy_kwh: EnergyKwh = Field(..., description="Energy used while standing here [kWh].")
+    soc_arrival: float
+    soc_departure: float
+
+
+class Totals(ApiModel):
+    """The whole round."""
+
+    distance_m: float
+    duration_s: float = Field(..., description="From departure to return, stops included [s].")
+    energy_kwh: EnergyKwh
+    energy_share: EnergyShare
+
+
+class BatteryOut(ApiModel):
+    """Whether the battery holds out with its reserve."""
+
+    feasible: bool
+    min_soc: float = Field(..., description="Lowest state of charge [–].")
+    final_soc: float = Field(..., description="State of charge at the end [–].")
+    margin_kwh: float = Field(..., description="Energy above the reserve at the lowest point.")
+    required_capacity_kwh: float = Field(..., description="Smallest usable capacity that works.")
+    first_infeasible_leg: int | None = Field(
+        None,
+        description="Index in legs[] of the leg (or the stop after it) that breaks the "
+        "reserve first; null when feasible.",
+    )
+
+
+class WeatherOut(ApiModel):
+    """The day's temperatures used."""
+
+    t_min_c: float
+    t_max_c: float
+    source: WeatherSource = Field(..., description="'request' or 'climatology'.")
+
+
+class BoxOut(ApiModel):
+    """Cargo-box temperatures (dynamic mode; null in steady mode)."""
+
+    max_temperature_c: float | None
+    minutes_above_product_limit: float | None
+
+
+class SolverOut(ApiModel):
+    """How the tour search ended."""
+
+    status: SolverStatus
+    objective: Objective
+    objective_value: float = Field(..., description="Of the tour, in m, s or Wh (estimate).")
+    runtime_s: float
+
+
+class PlanResponse(ApiModel):
+    """The planned and simulated round."""
+
+    tour: list[str] = Field(..., description="Ids in driving order, depot first and last.")
+    legs: list[LegOut]
+    stops: list[StopOut]
+    totals: Totals
+    battery: BatteryOut
+    weather: WeatherOut
+    timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
+    box: BoxOut
+    solver: SolverOut
+
+
+class CycleRequest(ApiModel):
+    """Generate a speed trace (paper §2.2) instead of sending one."""
+
+    street_type: StreetTypeName = "urban"
+    distance_m: float = Field(..., gt=0, le=1_000_000, description="Distance [m].")
+    driver_aggressiveness: float = Field(NORMAL_DRIVER, ge=0, le=1, description="ε_d [–].")
+    traffic_density: float | None = Field(None, gt=0, lt=1, description="ε_t [–].")
+
+
+class SimulateRequest(VanRequest):
+    """One trace: either ``speed_mps`` with ``dt_s`` or a ``cycle`` to generate."""
+
+    speed_mps: list[float] | None = Field(
+        None, description="Speed samples [m/s], 0–69.4, every dt_s seconds."
+    )
+    dt_s: float = Field(1.0, gt=0, le=3600, description="Sampling interval [s].")
+    grade: float | list[float] = Field(
+        0.0, description="Road grade [–], one number or one per sample, within ±0.5."
+    )
+    cycle: CycleRequest | None = None
+    start: AwareDatetime = Field(..., description="Start time, ISO 8601 with UTC offset.")
+    location: Location
+    weather: Weather | None = None
+    door_openings: list[DoorOpening] = Field(default_factory=list)
+    include_series: bool = Field(False, description="Return the time series too.")
+
+    @model_validator(mode="after")
+    def _one_trace(self) -> Self:
+        if (self.speed_mps is None) == (self.cycle is None):
+            raise ValueError("give exactly one of speed_mps and cycle")
+        return self
+
+
+class PowerSeries(ApiModel):
+    """Mean power of each consumer over the step ending at each sample [W] (0 at the start)."""
+
+    traction: list[float]
+    auxiliaries: list[float]
+    cabin: list[float]
+    refrigeration: list[float]
+
+
+class Series(ApiModel):
+    """Time series at the trace's samples."""
+
+    time_s: list[float]
+    speed_mps: list[float]
+    power_w: PowerSeries
+    soc: list[float]
+
+
+class ConsumptionWhPerKm(ApiModel):
+    """Energy per distance [Wh/km]; null for a trace that does not move."""
+
+    traction: float | None
+    auxiliaries: float | None
+    cabin: float | None
+    refrigeration: float | None
+    total: float | None
+
+
+class SimulateResponse(ApiModel):
+    """Energy of one trace."""
+
+    distance_m: float
+    duration_s: float
+    energy_kwh: EnergyKwh
+    consumption_wh_per_km: ConsumptionWhPerKm
+    battery: BatteryOut
+    weather: WeatherOut
+    box: BoxOut
+    series: Series | None = None
+
+
+class PresetsResponse(ApiModel):
+    """Every preset with every value."""
+
+    presets: list[Preset]
+
+
+class Health(ApiModel):
+    """Liveness."""
+
+    status: Literal["ok"] = "ok"
+    version: str

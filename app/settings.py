@@ -1,0 +1,38 @@
+"""Service settings from the environment (prefix ``COLDROUTE_``)."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+from pydantic import Field, SecretStr
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+
+class Settings(BaseSettings):
+    """Every knob of the service; each is an environment variable ``COLDROUTE_<NAME>``."""
+
+    model_config = SettingsConfigDict(env_prefix="COLDROUTE_", frozen=True)
+
+    host: str = Field("0.0.0.0", description="Interface uvicorn listens on.")
+    port: int = Field(8000, ge=1, le=65535, description="Port uvicorn listens on.")
+    log_level: str = Field("info", description="Python log level of the request log.")
+    cors_origins: list[str] = Field(
+        default_factory=list, description='Allowed CORS origins, JSON list: ["https://a.b"].'
+    )
+    api_key: SecretStr | None = Field(
+        None, description="When set, every /v1 request needs this value in X-API-Key."
+    )
+    max_stops: int = Field(500, ge=1, description="Most stops in one round.")
+    max_trace_samples: int = Field(
+        200_000, ge=2, description="Most samples in one simulated trace (55 h at 1 Hz)."
+    )
+    max_body_bytes: int = Field(10_000_000, ge=1024, description="Largest request body [bytes].")
+    max_time_limit_s: float = Field(
+        10.0, gt=0, description="Cap on a request's solver time_limit_s [s]."
+    )
+
+
+@lru_cache
+def get_settings() -> Settings:
+    """The settings, read once from the environment."""
+    return Settings()
