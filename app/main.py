@@ -15,6 +15,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from app import errors
 from app.routers import health, plans, presets, simulate
+from app.schemas import Problem
 from app.settings import Settings, get_settings
 
 _log = logging.getLogger("coldroute.requests")
@@ -137,7 +138,19 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         title="coldroute",
         version=version("coldroute"),
         description=DESCRIPTION,
-        responses={422: {"description": "Invalid request (problem+json)"}},
+        responses={
+            status: {
+                "model": Problem,
+                "description": description,
+                "content": {errors.PROBLEM_JSON: {}},
+            }
+            for status, description in (
+                (400, "Unreadable body"),
+                (401, "Missing or wrong X-API-Key"),
+                (413, "Request body too large"),
+                (422, "Invalid request, fields named"),
+            )
+        },
     )
     app.dependency_overrides[get_settings] = lambda: settings
     errors.install(app)

@@ -140,7 +140,7 @@ class PlanRequest(VanRequest):
         max_length=64,
         description="IANA time zone (Europe/Vienna); absent: local mean solar time at the depot.",
     )
-    depot: Depot
+    depot: Depot = Field(..., description="Where the round starts and ends.")
     stops: list[Stop] = Field(..., min_length=1, description="The stops, in any order.")
     weather: Weather | None = Field(
         None, description="The day's forecast; absent: the climatology for date and latitude."
@@ -274,7 +274,7 @@ class PlanResponse(ApiModel):
 class CycleRequest(ApiModel):
     """Generate a speed trace (paper §2.2) instead of sending one."""
 
-    street_type: StreetTypeName = "urban"
+    street_type: StreetTypeName = Field("urban", description="Street type preset.")
     distance_m: float = Field(..., gt=0, le=1_000_000, description="Distance [m].")
     driver_aggressiveness: float = Field(NORMAL_DRIVER, ge=0, le=1, description="ε_d [–].")
     traffic_density: float | None = Field(None, gt=0, lt=1, description="ε_t [–].")
@@ -286,15 +286,19 @@ class SimulateRequest(VanRequest):
     speed_mps: list[float] | None = Field(
         None, description="Speed samples [m/s], 0–69.4, every dt_s seconds."
     )
-    dt_s: float = Field(1.0, gt=0, le=3600, description="Sampling interval [s].")
+    dt_s: float = Field(1.0, ge=0.01, le=3600, description="Sampling interval [s].")
     grade: float | list[float] = Field(
         0.0, description="Road grade [–], one number or one per sample, within ±0.5."
     )
-    cycle: CycleRequest | None = None
+    cycle: CycleRequest | None = Field(None, description="Generate the trace instead.")
     start: AwareDatetime = Field(..., description="Start time, ISO 8601 with UTC offset.")
-    location: Location
-    weather: Weather | None = None
-    door_openings: list[DoorOpening] = Field(default_factory=list)
+    location: Location = Field(..., description="Where the van drives (sun, climatology).")
+    weather: Weather | None = Field(
+        None, description="The day's forecast; absent: the climatology for date and latitude."
+    )
+    door_openings: list[DoorOpening] = Field(
+        default_factory=list, description="Cargo-door openings, seconds after the start."
+    )
     include_series: bool = Field(False, description="Return the time series too.")
 
     @model_validator(mode="after")
@@ -349,6 +353,24 @@ class PresetsResponse(ApiModel):
     """Every preset with every value."""
 
     presets: list[Preset]
+
+
+class FieldError(ApiModel):
+    """One offending field."""
+
+    field: str = Field(..., description="Path of the field, like stops[3].lat.")
+    message: str = Field(..., description="The rule it breaks.")
+    type: str = Field(..., description="Machine-readable error kind.")
+
+
+class Problem(ApiModel):
+    """An error, RFC 9457 (application/problem+json)."""
+
+    type: str = Field(..., description="Problem kind, a relative URI.")
+    title: str
+    status: int
+    detail: str
+    errors: list[FieldError] | None = Field(None, description="For invalid requests.")
 
 
 class Health(ApiModel):

@@ -26,10 +26,12 @@ from pathlib import Path
 import numpy as np
 
 from core.arrays import FloatArray
-from core.exceptions import InvalidParameterError
+from core.exceptions import InvalidParameterError, LimitExceededError
 from core.params import CALM_DRIVER, NEDC_DURATION_S, StreetType
 
 KMH = 1 / 3.6
+#: Most samples one generated leg may have (about 58 days at 1 Hz): beyond, inputs are absurd.
+MAX_LEG_SAMPLES = 5_000_000
 
 
 def trace_distance_m(speed_mps: FloatArray, dt_s: float) -> float:
@@ -96,6 +98,12 @@ def generate_leg(
     _check_leg_inputs(distance_m, driver_aggressiveness, traffic_density, dt_s)
     if distance_m == 0:
         return np.zeros(1)
+    if distance_m / street.mean_speed_mps / dt_s > MAX_LEG_SAMPLES:
+        raise LimitExceededError(
+            f"a {distance_m:g} m leg sampled every {dt_s:g} s needs more than "
+            f"{MAX_LEG_SAMPLES:,} samples",
+            "distance_m",
+        )
     density = street.traffic_density if traffic_density is None else traffic_density
     accel = driver_aggressiveness * max_acceleration_mps2
     ramp_accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2

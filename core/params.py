@@ -92,7 +92,7 @@ class VehicleParams(Params):
     )
     drivetrain_efficiency: float = Field(
         0.85,
-        gt=0,
+        ge=0.1,
         le=1,
         description="Battery-to-wheel efficiency when motoring η_el [–] (eq. 7); 0.85 is the "
         "typical BEV figure NREL FASTSim uses.",
@@ -109,7 +109,7 @@ class VehicleParams(Params):
     )
     max_acceleration_mps2: float = Field(
         2.0,
-        gt=0,
+        ge=0.1,
         le=10,
         description="Maximum acceleration v̇_max [m/s²] (§2.2); 2.0 ≈ 0–100 km/h in 14 s.",
     )
@@ -130,7 +130,7 @@ class VehicleParams(Params):
 class CargoBoxParams(Params):
     """The insulated cargo box and its refrigeration unit (paper §3)."""
 
-    volume_m3: float = Field(8.0, gt=0, le=100, description="Inner volume V [m³] (Table 1).")
+    volume_m3: float = Field(8.0, ge=0.1, le=100, description="Inner volume V [m³] (Table 1).")
     wall_heat_transfer_w_m2k: float = Field(
         2.172,
         gt=0,
@@ -155,7 +155,7 @@ class CargoBoxParams(Params):
     )
     cop: float = Field(
         1.5,
-        gt=0,
+        ge=0.1,
         le=10,
         description="Coefficient of performance of the refrigeration unit η_RU [–] (eq. 12); 1.5 "
         "is typical of small electric units at 30 °C ambient, chilled box.",
@@ -239,7 +239,7 @@ class BatteryParams(Params):
     """Traction battery as seen by the energy balance."""
 
     usable_capacity_kwh: float = Field(
-        40.0, gt=0, le=2000, description="Usable battery capacity [kWh]."
+        40.0, ge=0.1, le=2000, description="Usable battery capacity [kWh]."
     )
     initial_soc: float = Field(1.0, gt=0, le=1, description="State of charge at departure [–].")
     min_soc: float = Field(

@@ -22,7 +22,7 @@ from pydantic import Field
 from core.arrays import FloatArray
 from core.battery import JOULES_PER_KWH, BatteryVerdict
 from core.cycles import generate_leg, stretch_to_duration, trace_distance_m
-from core.exceptions import InvalidParameterError, InvalidStopsError
+from core.exceptions import InvalidParameterError, InvalidStopsError, LimitExceededError
 from core.geo import MAX_LEG_GRADE, STREET_TYPE_NAMES, Legs, build_legs
 from core.params import (
     NORMAL_DRIVER,
@@ -45,6 +45,8 @@ from core.weather import WeatherSource
 
 #: Sampling interval of the day's simulation [s].
 PLAN_DT_S = 1.0
+#: Longest round the planner simulates [s] (a week): longer inputs are mistakes.
+MAX_ROUND_S = 7 * 86_400.0
 #: Length of the flat reference leg that calibrates the energy objective per street type [m].
 _REFERENCE_LEG_M = 10_000.0
 
@@ -133,6 +135,15 @@ def plan(problem: PlanProblem) -> PlanResult:
     cost, unit_value, offset = _cost_matrix(problem, legs, start)
     tour = solve_tour(cost, problem.time_limit_s, problem.keep_order)
     order = tour.order
+    round_s = float(legs.duration_s[order[:-1], order[1:]].sum()) + sum(
+        stop.service_time_s for stop in problem.stops
+    )
+    if round_s > MAX_ROUND_S:
+        raise LimitExceededError(
+            f"the round would last {round_s / 3600:,.0f} h; the planner simulates at most "
+            f"{MAX_ROUND_S / 3600:.0f} h",
+            "stops",
+        )
     objective_value = tour.cost * unit_value + offset * (len(order) - 1)
 
     speed, grade, payload, doors, marks = _timeline(problem, legs, order)

@@ -43,6 +43,14 @@ def simulate_trace(
     van = request.van()
     if request.cycle is not None:
         cycle = request.cycle
+        street = STREET_TYPES[cycle.street_type]
+        # Check the size before generating: a trace at least as long as cruising at v̄.
+        if cycle.distance_m / street.mean_speed_mps / request.dt_s > settings.max_trace_samples:
+            raise LimitExceededError(
+                f"a {cycle.distance_m:g} m {cycle.street_type} trace at dt_s {request.dt_s:g} "
+                f"has more than {settings.max_trace_samples} samples",
+                "cycle.distance_m",
+            )
         speed = generate_leg(
             cycle.distance_m,
             STREET_TYPES[cycle.street_type],

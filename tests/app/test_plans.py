@@ -1,0 +1,128 @@
+import copy
+
+import pytest
+
+from app.examples import PLAN_EXAMPLE
+
+PROBLEM = "application/problem+json"
+
+
+def test_swagger_example_runs_as_is(client):
+    response = client.post("/v1/plans", json=PLAN_EXAMPLE)
+    assert response.status_code == 200
+    body = response.json()
+    ids = [s["id"] for s in PLAN_EXAMPLE["stops"]]
+    assert body["tour"][0] == body["tour"][-1] == "depot-simmering"
+    assert sorted(body["tour"][1:-1]) == sorted(ids)
+    assert len(body["legs"]) == 9 and len(body["stops"]) == 8
+    leg = body["legs"][0]
+    assert set(leg) >= {
+        "from_id",
+        "to_id",
+        "depart",
+        "arrive",
+        "distance_m",
+        "duration_s",
+        "street_type",
+        "grade",
+        "energy_kwh",
+        "soc_start",
+        "soc_end",
+    }
+    assert leg["depart"] == "2026-07-15T09:00:00+02:00"
+    assert set(leg["energy_kwh"]) == {"traction", "auxiliaries", "cabin", "refrigeration", "total"}
+    totals = body["totals"]["energy_kwh"]
+    assert totals["total"] == pytest.approx(
+        sum(leg["energy_kwh"]["total"] for leg in body["legs"])
+        + sum(stop["energy_kwh"]["total"] for stop in body["stops"])
+    )
+    assert body["battery"]["feasible"] is True and body["battery"]["first_infeasible_leg"] is None
+    assert body["weather"] == {"t_min_c": 18, "t_max_c": 31, "source": "request"}
+    assert body["solver"]["status"] == "optimal" and body["solver"]["objective"] == "energy"
+    assert body["stops"][-1]["payload_after_kg"] == pytest.approx(550 - 210)
+
+
+def test_overrides_change_the_answer(client):
+    heavy = copy.deepcopy(PLAN_EXAMPLE) | {"keep_order": True}
+    light = heavy | {"vehicle": {"preset": "paper-generic", "mass_kg": 1200}}
+    a = client.post("/v1/plans", json=heavy).json()
+    b = client.post("/v1/plans", json=light).json()
+    assert b["totals"]["energy_kwh"]["traction"] < a["totals"]["energy_kwh"]["traction"]
+    assert a["solver"]["status"] == "fixed_order"
+
+
+def test_small_battery_is_reported_infeasible(client):
+    body = client.post(
+        "/v1/plans", json=PLAN_EXAMPLE | {"battery": {"usable_capacity_kwh": 4, "min_soc": 0.2}}
+    ).json()
+    assert body["battery"]["feasible"] is False
+    assert isinstance(body["battery"]["first_infeasible_leg"], int)
+    assert body["battery"]["required_capacity_kwh"] > 4
+
+
+def _stops(n):
+    return [{"id": f"S{i}", "lat": 48.2 + i * 1e-3, "lon": 16.37} for i in range(n)]
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        ({"depot": {"lat": 200, "lon": 16}}, "depot.lat"),
+        ({"stops": []}, "stops"),
+        ({"stops": _stops(41)}, "stops"),
+        (
+            {
+                "stops": [
+                    {"id": "A", "lat": 48.2, "lon": 16.3},
+                    {"id": "A", "lat": 48.3, "lon": 16.3},
+                ]
+            },
+            "stops[1].id",
+        ),
+        ({"vehicle": {"mass_kg": -5}}, "vehicle.mass_kg"),
+        ({"vehicle": {"preset": "tesla-semi"}}, "preset"),
+        ({"vehicle": {"drivetrain_efficiency": 1.5}}, "vehicle.drivetrain_efficiency"),
+        ({"cargo_box": {"setpoint_c": 10}}, "cargo_box"),
+        ({"battery": {"initial_soc": 0.1, "min_soc": 0.2}}, "battery"),
+        ({"date": "2026-13-45"}, "date"),
+        ({"start_time": "25:00"}, "start_time"),
+        ({"timezone": "Mars/Olympus"}, "timezone"),
+        ({"objective": "fun"}, "objective"),
+        ({"payload_kg": -1}, "payload_kg"),
+        ({"weather": {"t_min_c": 30, "t_max_c": 10}}, "weather"),
+        ({"matrix": {"distances_m": [[0]], "durations_s": [[0]]}}, "matrix.distances_m"),
+        ({"unknown_field": 1}, "unknown_field"),
+    ],
+)
+def test_bad_plans_get_a_problem_naming_the_field(client, change, field):
+    response = client.post("/v1/plans", json=PLAN_EXAMPLE | change)
+    assert response.status_code == 422
+    assert response.headers["content-type"] == PROBLEM
+    body = response.json()
+    assert body["status"] == 422 and body["title"] and body["detail"]
+    assert any(e["field"] == field for e in body["errors"]), body["errors"]
+
+
+def test_nan_and_malformed_json(client):
+    nan = client.post(
+        "/v1/plans",
+        content=b'{"date": "2026-07-15", "depot": {"lat": NaN, '
+        b'"lon": 16}, "stops": [{"id": "a", "lat": 48, "lon": 16}]}',
+        headers={"content-type": "application/json"},
+    )
+    assert nan.status_code == 422 and nan.json()["errors"][0]["field"] == "depot.lat"
+    broken = client.post(
+        "/v1/plans", content=b'{"date": ', headers={"content-type": "application/json"}
+    )
+    assert broken.status_code == 422 and broken.headers["content-type"] == PROBLEM
+
+
+def test_oversized_body_is_413(client):
+    huge = PLAN_EXAMPLE | {"stops": _stops(10_000)}  # > 200 kB, the test limit
+    response = client.post("/v1/plans", json=huge)
+    assert response.status_code == 413 and response.json()["title"] == "Request too large"
+
+
+def test_time_limit_is_capped_by_the_server(client):
+    body = client.post("/v1/plans", json=PLAN_EXAMPLE | {"time_limit_s": 500}).json()
+    assert body["solver"]["runtime_s"] < 0.5 + 0.2
