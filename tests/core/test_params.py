@@ -35,12 +35,12 @@ def test_paper_generic_carries_table_1():
     [
         (VehicleParams, "mass_kg", -1.0, "greater than 0"),
         (VehicleParams, "drivetrain_efficiency", 1.2, "less than or equal to 1"),
-        (VehicleParams, "drivetrain_efficiency", 0.0, "greater than 0"),
+        (VehicleParams, "drivetrain_efficiency", 0.0, "greater than or equal to 0.1"),
         (VehicleParams, "regen_efficiency", math.nan, "finite"),
         (VehicleParams, "drag_coefficient", math.inf, "finite"),
-        (CargoBoxParams, "cop", -2.0, "greater than 0"),
+        (CargoBoxParams, "cop", -2.0, "greater than or equal to 0.1"),
         (CargoBoxParams, "curtain_effectiveness", 1.0, "less than 1"),
-        (BatteryParams, "usable_capacity_kwh", 0.0, "greater than 0"),
+        (BatteryParams, "usable_capacity_kwh", 0.0, "greater than or equal to 0.1"),
     ],
 )
 def test_bad_parameter_names_field_and_rule(model, field, value, rule):
