@@ -1,6 +1,6 @@
 """Run every benchmark: ``python -m benchmarks`` (``make bench``)."""
 
-from benchmarks import bench_energy, bench_planner
+from benchmarks import bench_energy, bench_http, bench_planner
 
-for module in (bench_energy, bench_planner):
+for module in (bench_energy, bench_planner, bench_http):
     module.main()
