@@ -14,7 +14,7 @@ $(STAMP): pyproject.toml
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/ruff format --check .
+	$(BIN)/ruff format --check core app tests benchmarks
 	$(BIN)/mypy core app
 
 test: lint
