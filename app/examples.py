@@ -60,3 +60,24 @@ SIMULATE_TRACE_EXAMPLE: dict[str, Any] = {
     "vehicle": {"preset": "paper-generic", "mass_kg": 1900},
     "include_series": True,
 }
+
+SPEED_SWEEP_EXAMPLE: dict[str, Any] = {
+    "speeds_kmh": [20, 30, 40, 50, 60, 70, 80, 90, 100, 110, 120],
+    "distance_m": 20000,
+    "date": "2026-07-15",
+    "start_time": "12:00",
+    "timezone": "Europe/Vienna",
+    "location": {"lat": 48.21, "lon": 16.37},
+    "weather": {"t_min_c": 20, "t_max_c": 32},
+    "vehicle": {"preset": "paper-generic"},
+}
+
+SCENARIOS_EXAMPLE: dict[str, Any] = {
+    "plan": PLAN_EXAMPLE,
+    "seasons": [
+        {"name": "winter", "date": "2026-01-15", "weather": {"t_min_c": -10, "t_max_c": -2}},
+        {"name": "summer", "date": "2026-07-15", "weather": {"t_min_c": 18, "t_max_c": 31}},
+    ],
+    "driver_aggressiveness": [0.2, 0.5, 1.0],
+    "traffic_density": [0.2, 0.8],
+}

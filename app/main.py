@@ -14,7 +14,7 @@ from fastapi.middleware.cors import CORSMiddleware
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from app import errors
-from app.routers import health, plans, presets, simulate
+from app.routers import health, plans, presets, simulate, studies
 from app.schemas import Problem
 from app.settings import Settings, get_settings
 
@@ -155,7 +155,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.dependency_overrides[get_settings] = lambda: settings
     errors.install(app)
     v1 = APIRouter(prefix="/v1", dependencies=[Depends(require_api_key)])
-    for module in (plans, simulate, presets):
+    for module in (plans, simulate, presets, studies):
         v1.include_router(module.router)
     app.include_router(v1)
     app.include_router(health.router)

@@ -36,6 +36,7 @@ from core.params import (
     get_preset,
     inside_validation,
 )
+from core.studies import Season
 from core.tsp import SolverStatus
 from core.weather import WeatherSource
 
@@ -306,6 +307,90 @@ class SimulateRequest(VanRequest):
         if (self.speed_mps is None) == (self.cycle is None):
             raise ValueError("give exactly one of speed_mps and cycle")
         return self
+
+
+class SpeedSweepRequest(VanRequest):
+    """Constant-speed trips on a flat road at several speeds (paper Fig. 11)."""
+
+    speeds_kmh: list[float] = Field(
+        default_factory=lambda: [float(v) for v in range(20, 121, 10)],
+        min_length=1,
+        max_length=100,
+        description="Mean speeds to try [km/h], each in (0, 200].",
+    )
+    distance_m: float = Field(20_000.0, gt=0, le=500_000, description="Trip length [m].")
+    date: dt.date = Field(..., description="Day of the trips.")
+    start_time: str = Field(
+        "12:00", pattern=r"^([01]\d|2[0-3]):[0-5]\d$", description="Departure, local HH:MM."
+    )
+    timezone: str | None = Field(
+        None, max_length=64, description="IANA time zone; absent: local mean solar time."
+    )
+    location: Location = Field(..., description="Where (sun, climatology).")
+    weather: Weather | None = Field(
+        None, description="The day's forecast; absent: the climatology for date and latitude."
+    )
+    traffic_density: float | None = Field(None, gt=0, lt=1, description="ε_t [–].")
+    driver_aggressiveness: float = Field(
+        0.0, ge=0, le=1, description="ε_d [–]; 0 holds each speed exactly (paper Fig. 11)."
+    )
+
+
+class SpeedPointOut(ApiModel):
+    """One speed of the sweep."""
+
+    speed_kmh: float
+    energy_wh_per_km: ConsumptionWhPerKm
+
+
+class SpeedSweepResponse(ApiModel):
+    """Energy per km at each speed, and the speed with the lowest total."""
+
+    points: list[SpeedPointOut]
+    optimum_speed_kmh: float
+
+
+class ScenariosRequest(ApiModel):
+    """One round over seasons × driver aggressiveness × traffic density (paper Figs. 9, 10)."""
+
+    plan: PlanRequest = Field(..., description="The round and its baseline conditions.")
+    seasons: list[Season] | None = Field(
+        None,
+        min_length=1,
+        max_length=12,
+        description="Absent: winter (15 Jan) and summer (15 Jul) of the plan's year.",
+    )
+    driver_aggressiveness: list[float] | None = Field(
+        None,
+        min_length=1,
+        max_length=10,
+        description="ε_d values [–]; absent: calm 0.2, normal 0.5, aggressive 1.0.",
+    )
+    traffic_density: list[float] | None = Field(
+        None,
+        min_length=1,
+        max_length=10,
+        description="ε_t values [–]; absent: light 0.2, heavy 0.8.",
+    )
+
+
+class ScenarioCellOut(ApiModel):
+    """One cell of the grid."""
+
+    season: str
+    driver_aggressiveness: float
+    traffic_density: float | None
+    energy_kwh: EnergyKwh
+    change_vs_baseline_pct: float = Field(..., description="Total energy against the baseline.")
+    feasible: bool = Field(..., description="The battery holds out with its reserve.")
+
+
+class ScenariosResponse(ApiModel):
+    """The grid, one row per cell, on the baseline's tour."""
+
+    tour: list[str]
+    baseline_energy_kwh: EnergyKwh
+    cells: list[ScenarioCellOut]
 
 
 class PowerSeries(ApiModel):

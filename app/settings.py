@@ -27,6 +27,9 @@ class Settings(BaseSettings):
         200_000, ge=2, description="Most samples in one simulated trace (55 h at 1 Hz)."
     )
     max_body_bytes: int = Field(10_000_000, ge=1024, description="Largest request body [bytes].")
+    max_study_cell_stops: int = Field(
+        2000, ge=1, description="Most cells × stops in one scenario study."
+    )
     max_time_limit_s: float = Field(
         10.0, gt=0, description="Cap on a request's solver time_limit_s [s]."
     )

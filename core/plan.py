@@ -102,6 +102,26 @@ class StopResult:
     soc_departure: float
 
 
+#: Spacing of the day profile's points [s].
+PROFILE_STEP_S = 60.0
+
+
+@dataclass(frozen=True)
+class DayProfile:
+    """Cumulative energy per consumer over the clock time of the round (paper Fig. 8).
+
+    Attributes
+    ----------
+    time
+        Moments every minute from departure to return, local time.
+    energy_kwh
+        Energy used since departure at each moment, per consumer and ``total`` [kWh].
+    """
+
+    time: list[dt.datetime]
+    energy_kwh: dict[str, list[float]]
+
+
 @dataclass(frozen=True)
 class PlanResult:
     """The solved and simulated round."""
@@ -124,12 +144,15 @@ class PlanResult:
     objective: Objective
     objective_value: float
     solver_runtime_s: float
+    profile: DayProfile
 
 
 def plan(problem: PlanProblem) -> PlanResult:
     """Solve the round trip on the chosen objective and simulate it in full (paper Fig. 7)."""
     _check_stops(problem)
-    start, timezone_name = _departure(problem)
+    start, timezone_name = departure(
+        problem.date, problem.start_time, problem.timezone, problem.depot.lon
+    )
     places: list[Depot] = [problem.depot, *problem.stops]
     legs = build_legs(places, problem.matrix)
     cost, unit_value, offset = _cost_matrix(problem, legs, start)
@@ -192,24 +215,27 @@ def _check_stops(problem: PlanProblem) -> None:
         )
 
 
-def _departure(problem: PlanProblem) -> tuple[dt.datetime, str]:
-    """Departure time with its zone; local mean solar time at the depot when none is given."""
-    if problem.timezone is None:
-        offset = dt.timedelta(minutes=round(problem.depot.lon * 4))
+def departure(
+    date: dt.date, start_time: dt.time, timezone: str | None, lon: float
+) -> tuple[dt.datetime, str]:
+    """Departure time with its zone, and the zone's name; with no IANA zone, local mean solar
+    time at longitude ``lon`` [°] (UTC offset lon/15 h)."""
+    if timezone is None:
+        offset = dt.timedelta(minutes=round(lon * 4))
         zone: dt.tzinfo = dt.timezone(offset)
-        name = f"local mean solar time (UTC{'+' if offset >= dt.timedelta(0) else '-'}"
         minutes = abs(int(offset.total_seconds() // 60))
-        name += f"{minutes // 60:02d}:{minutes % 60:02d})"
+        sign = "+" if offset >= dt.timedelta(0) else "-"
+        name = f"local mean solar time (UTC{sign}{minutes // 60:02d}:{minutes % 60:02d})"
     else:
         try:
-            zone = ZoneInfo(problem.timezone)
+            zone = ZoneInfo(timezone)
         except (ZoneInfoNotFoundError, ValueError):
             raise InvalidParameterError(
-                f"unknown time zone '{problem.timezone}'; use an IANA name like Europe/Vienna",
+                f"unknown time zone '{timezone}'; use an IANA name like Europe/Vienna",
                 "timezone",
             ) from None
-        name = problem.timezone
-    return dt.datetime.combine(problem.date, problem.start_time, tzinfo=zone), name
+        name = timezone
+    return dt.datetime.combine(date, start_time, tzinfo=zone), name
 
 
 def _constant_power_w(problem: PlanProblem, start: dt.datetime) -> float:
@@ -405,6 +431,10 @@ def _assemble(
             )
     total = result.energy_kwh["total"]
     first_bad = result.battery.first_infeasible_index
+    every = max(round(PROFILE_STEP_S / PLAN_DT_S), 1)
+    picks = np.unique(np.append(np.arange(0, result.time_s.size, every), result.time_s.size - 1))
+    profile_kwh = {name: (c[picks] / JOULES_PER_KWH).tolist() for name, c in cumulative.items()}
+    profile_kwh["total"] = np.sum([profile_kwh[name] for name in CONSUMERS], axis=0).tolist()
     dynamic = problem.van.cargo_box.mode == "dynamic"
     return PlanResult(
         tour=[places[i].id for i in order],
@@ -429,4 +459,5 @@ def _assemble(
         objective=problem.objective,
         objective_value=objective_value,
         solver_runtime_s=runtime_s,
+        profile=DayProfile([at(int(i)) for i in picks], profile_kwh),
     )

@@ -25,6 +25,31 @@ from core.plan import PlanProblem, plan
 router = APIRouter(tags=["plans"])
 
 
+def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
+    """The core problem of a plan request, within the server's limits."""
+    if len(request.stops) > settings.max_stops:
+        raise LimitExceededError(
+            f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
+            "stops",
+        )
+    hour, minute = (int(part) for part in request.start_time.split(":"))
+    return PlanProblem(
+        date=request.date,
+        start_time=dt.time(hour, minute),
+        timezone=request.timezone,
+        depot=request.depot,
+        stops=request.stops,
+        van=request.van(),
+        weather=request.weather,
+        driver_aggressiveness=request.driver_aggressiveness,
+        traffic_density=request.traffic_density,
+        objective=request.objective,
+        matrix=request.matrix,
+        keep_order=request.keep_order,
+        time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
+    )
+
+
 @router.post("/plans", operation_id="createPlan", summary="Plan and simulate a delivery round")
 def create_plan(
     request: Annotated[

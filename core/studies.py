@@ -1,0 +1,243 @@
+"""What-if studies of the paper's section 4: best constant speed (Fig. 11), seasons × drivers ×
+traffic over one round (Figs. 9, 10) and the energy over the day (Fig. 8, ``PlanResult.profile``).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from pydantic import Field
+
+from core.cycles import generate_leg
+from core.exceptions import InvalidParameterError
+from core.params import (
+    AGGRESSIVE_DRIVER,
+    CALM_DRIVER,
+    NORMAL_DRIVER,
+    STREET_TYPES,
+    Location,
+    Params,
+    RoadMatrix,
+    StreetType,
+    VanParams,
+    Weather,
+)
+from core.plan import PlanProblem, PlanResult, plan
+from core.simulate import CONSUMERS, simulate
+
+#: Street type whose wave shape a swept speed borrows when the driver is not passive.
+SWEEP_SHAPE = "highway"
+
+
+@dataclass(frozen=True)
+class SpeedPoint:
+    """One speed of a sweep: energy per distance of each consumer and ``total`` [Wh/km]."""
+
+    speed_kmh: float
+    energy_wh_per_km: dict[str, float]
+
+
+@dataclass(frozen=True)
+class SpeedSweep:
+    """A sweep and its optimum (the speed with the lowest total energy per km)."""
+
+    points: list[SpeedPoint]
+    optimum_speed_kmh: float
+
+
+def speed_sweep(
+    speeds_kmh: Sequence[float],
+    distance_m: float,
+    start: dt.datetime,
+    location: Location,
+    van: VanParams,
+    weather: Weather | None = None,
+    driver_aggressiveness: float = 0.0,
+    traffic_density: float | None = None,
+) -> SpeedSweep:
+    """Energy per km of flat trips at each mean speed (paper Fig. 11).
+
+    Each trip starts and ends at rest and covers ``distance_m``. A passive driver
+    (``driver_aggressiveness`` 0, the paper's Fig. 10/11 setting) holds the speed; otherwise the
+    speed swings in the highway street type's trapezoid waves around it (paper §2.2), denser with
+    more traffic.
+
+    Parameters
+    ----------
+    speeds_kmh
+        Mean speeds [km/h], each in (0, 200].
+    distance_m
+        Trip length [m].
+    start, location, van, weather
+        As for :func:`core.simulate.simulate`.
+    """
+    if not speeds_kmh:
+        raise InvalidParameterError("speeds_kmh must hold at least one speed", "speeds_kmh")
+    shape = STREET_TYPES[SWEEP_SHAPE]
+    points = []
+    for index, speed_kmh in enumerate(speeds_kmh):
+        if not 0 < speed_kmh <= 200:
+            raise InvalidParameterError(
+                f"speeds_kmh[{index}] = {speed_kmh} must be within (0, 200] km/h",
+                f"speeds_kmh[{index}]",
+            )
+        street = StreetType(
+            mean_speed_mps=speed_kmh / 3.6,
+            speed_variation=shape.speed_variation,
+            period_divisor=shape.period_divisor,
+            traffic_density=shape.traffic_density,
+        )
+        trace = generate_leg(
+            distance_m,
+            street,
+            driver_aggressiveness,
+            van.vehicle.max_acceleration_mps2,
+            traffic_density,
+        )
+        result = simulate(trace, 1.0, start, location, van, weather=weather)
+        per_km = {k: v * 1e6 / result.distance_m for k, v in result.energy_kwh.items()}
+        points.append(SpeedPoint(speed_kmh, per_km))
+    best = min(points, key=lambda p: p.energy_wh_per_km["total"])
+    return SpeedSweep(points, best.speed_kmh)
+
+
+class Season(Params):
+    """A season of a scenario grid: a day and, optionally, its forecast."""
+
+    name: str = Field(..., min_length=1, max_length=40, description="Label, e.g. 'winter'.")
+    date: dt.date = Field(..., description="The day the round is driven.")
+    weather: Weather | None = Field(None, description="Forecast; absent: the climatology.")
+
+
+@dataclass(frozen=True)
+class ScenarioCell:
+    """One cell of the grid and its energy against the baseline."""
+
+    season: str
+    driver_aggressiveness: float
+    traffic_density: float | None
+    energy_kwh: dict[str, float]
+    change_vs_baseline_pct: float
+    feasible: bool
+
+
+@dataclass(frozen=True)
+class ScenarioGrid:
+    """A round evaluated over seasons × drivers × traffic, on the baseline's tour."""
+
+    tour: list[str]
+    baseline_energy_kwh: dict[str, float]
+    cells: list[ScenarioCell]
+
+
+def default_seasons(year: int) -> list[Season]:
+    """Winter (15 January) and summer (15 July) of ``year``, weather from the climatology."""
+    return [
+        Season(name="winter", date=dt.date(year, 1, 15)),
+        Season(name="summer", date=dt.date(year, 7, 15)),
+    ]
+
+
+DEFAULT_DRIVERS = (CALM_DRIVER, NORMAL_DRIVER, AGGRESSIVE_DRIVER)
+DEFAULT_TRAFFIC = (0.2, 0.8)
+
+
+def scenario_grid(
+    problem: PlanProblem,
+    seasons: Sequence[Season] | None = None,
+    drivers: Sequence[float] | None = None,
+    traffic: Sequence[float | None] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> ScenarioGrid:
+    """The round of ``problem`` over every combination of season, driver and traffic.
+
+    The tour is solved once for ``problem`` as given (the baseline) and kept for every cell, so
+    that cells differ only in their conditions; each cell is a full simulation of that tour
+    (the same as planning it with ``keep_order``). ``change_vs_baseline_pct`` compares a cell's
+    total energy with the baseline's.
+
+    Parameters
+    ----------
+    problem
+        The round and its baseline conditions.
+    seasons, drivers, traffic
+        The axes; None takes winter/summer, calm/normal/aggressive (ε_d 0.2, 0.5, 1.0) and
+        light/heavy traffic (ε_t 0.2, 0.8).
+    progress
+        Called with (cells done, cells in all) after each cell.
+    """
+    seasons = list(seasons) if seasons is not None else default_seasons(problem.date.year)
+    drivers = list(drivers) if drivers is not None else list(DEFAULT_DRIVERS)
+    traffic = list(traffic) if traffic is not None else list(DEFAULT_TRAFFIC)
+    for name, axis in (
+        ("seasons", seasons),
+        ("driver_aggressiveness", drivers),
+        ("traffic_density", traffic),
+    ):
+        if not axis:
+            raise InvalidParameterError(f"{name} must hold at least one value", name)
+    baseline = plan(problem)
+    by_id = {stop.id: stop for stop in problem.stops}
+    fixed = problem.model_copy(
+        update={
+            "stops": [by_id[i] for i in baseline.tour[1:-1]],
+            "keep_order": True,
+            "matrix": _reordered_matrix(problem, baseline),
+        }
+    )
+    cells = []
+    combos = list(itertools.product(seasons, drivers, traffic))
+    for done, (season, driver, density) in enumerate(combos, start=1):
+        result = plan(
+            fixed.model_copy(
+                update={
+                    "date": season.date,
+                    "weather": season.weather,
+                    "driver_aggressiveness": driver,
+                    "traffic_density": density,
+                }
+            )
+        )
+        cells.append(_cell(season.name, driver, density, result, baseline))
+        if progress is not None:
+            progress(done, len(combos))
+    return ScenarioGrid(baseline.tour, baseline.energy_kwh, cells)
+
+
+def _reordered_matrix(problem: PlanProblem, baseline: PlanResult) -> RoadMatrix | None:
+    """The client's matrices in the tour's stop order (None stays None)."""
+    if problem.matrix is None:
+        return None
+    position = {stop.id: index + 1 for index, stop in enumerate(problem.stops)}
+    order = [0] + [position[i] for i in baseline.tour[1:-1]]
+    m = problem.matrix
+
+    def pick(rows: list[list[float]]) -> list[list[float]]:
+        return [[rows[i][j] for j in order] for i in order]
+
+    return m.model_copy(
+        update={
+            "distances_m": pick(m.distances_m),
+            "durations_s": pick(m.durations_s),
+            "street_types": None
+            if m.street_types is None
+            else [[m.street_types[i][j] for j in order] for i in order],
+        }
+    )
+
+
+def _cell(
+    season: str, driver: float, density: float | None, result: PlanResult, baseline: PlanResult
+) -> ScenarioCell:
+    base = baseline.energy_kwh["total"]
+    return ScenarioCell(
+        season=season,
+        driver_aggressiveness=driver,
+        traffic_density=density,
+        energy_kwh={name: result.energy_kwh[name] for name in (*CONSUMERS, "total")},
+        change_vs_baseline_pct=(result.energy_kwh["total"] / base - 1) * 100 if base else 0.0,
+        feasible=result.battery.feasible,
+    )
