@@ -360,13 +360,13 @@ class ScenariosRequest(ApiModel):
         max_length=12,
         description="Absent: winter (15 Jan) and summer (15 Jul) of the plan's year.",
     )
-    driver_aggressiveness: list[float] | None = Field(
+    driver_aggressiveness: list[Annotated[float, Field(ge=0, le=1)]] | None = Field(
         None,
         min_length=1,
         max_length=10,
         description="ε_d values [–]; absent: calm 0.2, normal 0.5, aggressive 1.0.",
     )
-    traffic_density: list[float] | None = Field(
+    traffic_density: list[Annotated[float, Field(gt=0, lt=1)]] | None = Field(
         None,
         min_length=1,
         max_length=10,
