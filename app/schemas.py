@@ -40,6 +40,15 @@ from core.studies import Season
 from core.tsp import SolverStatus
 from core.weather import WeatherSource
 
+#: A local clock time as the API writes it.
+HHMM_PATTERN = r"^([01]\d|2[0-3]):[0-5]\d$"
+
+
+def clock_time(text: str) -> dt.time:
+    """``"09:30"`` → ``time(9, 30)`` (the text has passed :data:`HHMM_PATTERN`)."""
+    hour, minute = (int(part) for part in text.split(":"))
+    return dt.time(hour, minute)
+
 
 class ApiModel(BaseModel):
     """Base of the API's own models: no unknown fields, no NaN or infinity."""
@@ -133,9 +142,7 @@ class PlanRequest(VanRequest):
     """A delivery round to plan: depot, stops, date, van and conditions."""
 
     date: dt.date = Field(..., description="Day of the round, YYYY-MM-DD.")
-    start_time: str = Field(
-        "08:00", pattern=r"^([01]\d|2[0-3]):[0-5]\d$", description="Departure, local HH:MM."
-    )
+    start_time: str = Field("08:00", pattern=HHMM_PATTERN, description="Departure, local HH:MM.")
     timezone: str | None = Field(
         None,
         max_length=64,
@@ -320,9 +327,7 @@ class SpeedSweepRequest(VanRequest):
     )
     distance_m: float = Field(20_000.0, gt=0, le=500_000, description="Trip length [m].")
     date: dt.date = Field(..., description="Day of the trips.")
-    start_time: str = Field(
-        "12:00", pattern=r"^([01]\d|2[0-3]):[0-5]\d$", description="Departure, local HH:MM."
-    )
+    start_time: str = Field("12:00", pattern=HHMM_PATTERN, description="Departure, local HH:MM.")
     timezone: str | None = Field(
         None, max_length=64, description="IANA time zone; absent: local mean solar time."
     )

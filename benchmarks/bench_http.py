@@ -4,17 +4,13 @@ from __future__ import annotations
 
 import asyncio
 import copy
-import os
-import socket
-import subprocess
-import sys
 import time
 
 import httpx
 import numpy as np
 
 from app.examples import PLAN_EXAMPLE
-from benchmarks.common import print_table
+from benchmarks.common import print_table, running_server
 
 CLIENTS = 8
 REQUESTS = 64
@@ -60,33 +56,7 @@ async def _load(url: str, body: dict[str, object]) -> tuple[list[float], float, 
 
 
 def main() -> None:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
-    env = {k: v for k, v in os.environ.items() if k != "COLDROUTE_API_KEY"}
-    server = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "uvicorn",
-            "app.main:app",
-            "--host",
-            "127.0.0.1",
-            "--port",
-            str(port),
-            "--log-level",
-            "warning",
-        ],
-        env=env | {"COLDROUTE_LOG_LEVEL": "warning"},
-    )
-    url = f"http://127.0.0.1:{port}"
-    try:
-        for _ in range(100):
-            try:
-                httpx.get(f"{url}/healthz", timeout=1)
-                break
-            except httpx.TransportError:
-                time.sleep(0.1)
+    with running_server() as url:
         rows = []
         for n in (8, 50):
             body = _plan_with(n)
@@ -104,14 +74,11 @@ def main() -> None:
                     failures,
                 ]
             )
-        print_table(
-            "POST /v1/plans through uvicorn over HTTP (one worker process, 2 cores)",
-            ["stops", "clients", "requests", "p50 [ms]", "p95 [ms]", "requests/s", "non-200"],
-            rows,
-        )
-    finally:
-        server.terminate()
-        server.wait(timeout=10)
+    print_table(
+        "POST /v1/plans through uvicorn over HTTP (one worker process, 2 cores)",
+        ["stops", "clients", "requests", "p50 [ms]", "p95 [ms]", "requests/s", "non-200"],
+        rows,
+    )
 
 
 if __name__ == "__main__":

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import os
+import socket
+import subprocess
+import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
+import httpx
 import numpy as np
 
 REFERENCE = Path(__file__).resolve().parents[1].parent / "shared" / "reference"
@@ -44,3 +50,42 @@ def euc_2d_matrix(path: Path) -> np.ndarray:
     xy = np.array(points)
     distance = np.sqrt(((xy[:, None, :] - xy[None, :, :]) ** 2).sum(axis=-1))
     return np.floor(distance + 0.5).astype(np.int64)
+
+
+@contextmanager
+def running_server(env: dict[str, str] | None = None) -> Iterator[str]:
+    """The real service (uvicorn, a free loopback port) for the duration; yields its URL."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    environment = {k: v for k, v in os.environ.items() if not k.startswith("COLDROUTE_")}
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "uvicorn",
+            "app.main:app",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            str(port),
+            "--log-level",
+            "warning",
+        ],
+        env=environment | {"COLDROUTE_LOG_LEVEL": "warning"} | (env or {}),
+        stdout=subprocess.DEVNULL,
+    )
+    url = f"http://127.0.0.1:{port}"
+    try:
+        for _ in range(150):
+            try:
+                if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
+                    break
+            except httpx.TransportError:
+                time.sleep(0.1)
+        else:
+            raise RuntimeError("the server did not start within 15 s")
+        yield url
+    finally:
+        process.terminate()
+        process.wait(timeout=10)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import datetime as dt
 from typing import Annotated
 
 from fastapi import APIRouter, Body, Depends
@@ -17,6 +16,7 @@ from app.schemas import (
     SolverOut,
     StopOut,
     Totals,
+    clock_time,
 )
 from app.settings import Settings, get_settings
 from core.exceptions import LimitExceededError
@@ -32,10 +32,9 @@ def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
             f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
             "stops",
         )
-    hour, minute = (int(part) for part in request.start_time.split(":"))
     return PlanProblem(
         date=request.date,
-        start_time=dt.time(hour, minute),
+        start_time=clock_time(request.start_time),
         timezone=request.timezone,
         depot=request.depot,
         stops=request.stops,
@@ -67,28 +66,7 @@ def create_plan(
 ) -> PlanResponse:
     """Orders the stops (OR-Tools), simulates every leg and stop with the paper's model and says
     whether the battery holds out. Runs in a worker thread, off the event loop."""
-    if len(request.stops) > settings.max_stops:
-        raise LimitExceededError(
-            f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
-            "stops",
-        )
-    hour, minute = (int(part) for part in request.start_time.split(":"))
-    problem = PlanProblem(
-        date=request.date,
-        start_time=dt.time(hour, minute),
-        timezone=request.timezone,
-        depot=request.depot,
-        stops=request.stops,
-        van=request.van(),
-        weather=request.weather,
-        driver_aggressiveness=request.driver_aggressiveness,
-        traffic_density=request.traffic_density,
-        objective=request.objective,
-        matrix=request.matrix,
-        keep_order=request.keep_order,
-        time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
-    )
-    result = plan(problem)
+    result = plan(plan_problem(request, settings))
     return PlanResponse(
         tour=result.tour,
         legs=[

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import datetime as dt
 from typing import Annotated
 
 from fastapi import APIRouter, Body, Depends
@@ -18,6 +17,7 @@ from app.schemas import (
     SpeedPointOut,
     SpeedSweepRequest,
     SpeedSweepResponse,
+    clock_time,
 )
 from app.settings import Settings, get_settings
 from core.exceptions import LimitExceededError
@@ -43,9 +43,8 @@ def sweep_speeds(
 ) -> SpeedSweepResponse:
     """Energy per km of each consumer on flat trips at each speed, and the speed with the
     lowest total: with the cooling unit on, about 40 km/h (paper Fig. 11)."""
-    hour, minute = (int(part) for part in request.start_time.split(":"))
     start, _ = departure(
-        request.date, dt.time(hour, minute), request.timezone, request.location.lon
+        request.date, clock_time(request.start_time), request.timezone, request.location.lon
     )
     sweep = speed_sweep(
         request.speeds_kmh,
