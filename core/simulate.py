@@ -79,12 +79,6 @@ class SimulationResult:
     weather: Weather
     weather_source: WeatherSource
 
-    @property
-    def step_energy_j(self) -> FloatArray:
-        """Total electric energy of each step [J]."""
-        dt_s = self.time_s[1] - self.time_s[0]
-        return sum(self.power_w.values(), np.zeros(self.time_s.size - 1)) * dt_s
-
 
 @dataclass(frozen=True)
 class LocalClock:
