@@ -325,7 +325,9 @@ class SpeedSweepRequest(VanRequest):
         max_length=100,
         description="Mean speeds to try [km/h], each in (0, 200].",
     )
-    distance_m: float = Field(20_000.0, gt=0, le=500_000, description="Trip length [m].")
+    distance_m: float = Field(
+        20_000.0, ge=100, le=500_000, description="Trip length [m], at least 100 m."
+    )
     date: dt.date = Field(..., description="Day of the trips.")
     start_time: str = Field("12:00", pattern=HHMM_PATTERN, description="Departure, local HH:MM.")
     timezone: str | None = Field(
@@ -417,7 +419,7 @@ class Series(ApiModel):
 
 
 class ConsumptionWhPerKm(ApiModel):
-    """Energy per distance [Wh/km]; null for a trace that does not move."""
+    """Energy per distance [Wh/km]; null for a trace that moves less than a metre."""
 
     traction: float | None
     auxiliaries: float | None

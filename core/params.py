@@ -14,9 +14,16 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from typing import Any, Literal, Self
+from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+)
 
 from core.exceptions import InvalidParameterError
 
@@ -221,11 +228,12 @@ class CargoBoxParams(Params):
         "hold the set-point. The paper's van has no heater.",
     )
 
-    @model_validator(mode="after")
-    def _limit_above_setpoint(self) -> Self:
-        if self.product_limit_c <= self.setpoint_c:
+    @field_validator("product_limit_c")
+    @classmethod
+    def _limit_above_setpoint(cls, value: float, info: ValidationInfo) -> float:
+        if "setpoint_c" in info.data and value <= info.data["setpoint_c"]:
             raise ValueError("product_limit_c must be above setpoint_c")
-        return self
+        return value
 
     @property
     def heat_transfer_area_m2(self) -> float:
@@ -233,6 +241,10 @@ class CargoBoxParams(Params):
         if self.wall_area_m2 is not None:
             return self.wall_area_m2
         return 2.0 * (self.roof_area_m2 + self.side_area_m2 + self.back_area_m2)
+
+
+#: Smallest usable state-of-charge window ``initial_soc − min_soc`` [–].
+MIN_SOC_WINDOW = 0.01
 
 
 class BatteryParams(Params):
@@ -246,11 +258,12 @@ class BatteryParams(Params):
         0.1, ge=0, lt=1, description="Reserve: lowest acceptable state of charge [–]."
     )
 
-    @model_validator(mode="after")
-    def _reserve_below_start(self) -> Self:
-        if self.min_soc >= self.initial_soc:
-            raise ValueError("min_soc must be below initial_soc")
-        return self
+    @field_validator("min_soc")
+    @classmethod
+    def _reserve_below_start(cls, value: float, info: ValidationInfo) -> float:
+        if "initial_soc" in info.data and value > info.data["initial_soc"] - MIN_SOC_WINDOW:
+            raise ValueError(f"min_soc must be at least {MIN_SOC_WINDOW} below initial_soc")
+        return value
 
 
 class Weather(Params):
@@ -259,11 +272,12 @@ class Weather(Params):
     t_min_c: float = Field(..., ge=-60, le=60, description="Lowest temperature of the day [°C].")
     t_max_c: float = Field(..., ge=-60, le=60, description="Highest temperature of the day [°C].")
 
-    @model_validator(mode="after")
-    def _ordered(self) -> Self:
-        if self.t_min_c > self.t_max_c:
+    @field_validator("t_max_c")
+    @classmethod
+    def _ordered(cls, value: float, info: ValidationInfo) -> float:
+        if "t_min_c" in info.data and info.data["t_min_c"] > value:
             raise ValueError("t_min_c must not exceed t_max_c")
-        return self
+        return value
 
 
 class Location(Params):
@@ -401,11 +415,12 @@ class Stop(Depot):
     )
     delivery_kg: float = Field(0.0, ge=0, le=40_000, description="Payload unloaded here [kg].")
 
-    @model_validator(mode="after")
-    def _door_within_service(self) -> Self:
-        if self.door_open_s > self.service_time_s:
+    @field_validator("door_open_s")
+    @classmethod
+    def _door_within_service(cls, value: float, info: ValidationInfo) -> float:
+        if "service_time_s" in info.data and value > info.data["service_time_s"]:
             raise ValueError("door_open_s must not exceed service_time_s")
-        return self
+        return value
 
 
 class RoadMatrix(Params):

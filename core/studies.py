@@ -28,6 +28,8 @@ from core.params import (
 from core.plan import PlanProblem, PlanResult, plan
 from core.simulate import CONSUMERS, simulate
 
+#: Shortest swept trip [m]: shorter ones are all ramp and say nothing about a cruising speed.
+MIN_SWEEP_DISTANCE_M = 100.0
 #: Street type whose wave shape a swept speed borrows when the driver is not passive.
 SWEEP_SHAPE = "highway"
 
@@ -70,12 +72,17 @@ def speed_sweep(
     speeds_kmh
         Mean speeds [km/h], each in (0, 200].
     distance_m
-        Trip length [m].
+        Trip length [m], at least 100 m.
     start, location, van, weather
         As for :func:`core.simulate.simulate`.
     """
     if not speeds_kmh:
         raise InvalidParameterError("speeds_kmh must hold at least one speed", "speeds_kmh")
+    if not distance_m >= MIN_SWEEP_DISTANCE_M:
+        raise InvalidParameterError(
+            f"distance_m must be at least {MIN_SWEEP_DISTANCE_M:g} m, got {distance_m}",
+            "distance_m",
+        )
     shape = STREET_TYPES[SWEEP_SHAPE]
     points = []
     for index, speed_kmh in enumerate(speeds_kmh):

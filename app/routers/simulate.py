@@ -17,6 +17,8 @@ from core.params import STREET_TYPES
 from core.simulate import simulate
 
 router = APIRouter(tags=["simulation"])
+#: Shortest distance for which energy per km is reported [m].
+MIN_DISTANCE_FOR_PER_KM_M = 1.0
 
 
 @router.post("/simulate", operation_id="simulateTrace", summary="Energy of one speed trace")
@@ -78,7 +80,9 @@ def simulate_trace(
         door_openings=request.door_openings,
     )
     km = result.distance_m / 1000
-    per_km = {k: (v * 1000 / km if km > 0 else None) for k, v in result.energy_kwh.items()}
+    # Per-km figures of a trace that (nearly) stands still mean nothing: null below a metre.
+    moved = result.distance_m >= MIN_DISTANCE_FOR_PER_KM_M
+    per_km = {k: (v * 1000 / km if moved else None) for k, v in result.energy_kwh.items()}
     series = None
     if request.include_series:
         series = Series(

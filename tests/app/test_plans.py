@@ -82,14 +82,22 @@ def _stops(n):
         ({"vehicle": {"mass_kg": -5}}, "vehicle.mass_kg"),
         ({"vehicle": {"preset": "tesla-semi"}}, "preset"),
         ({"vehicle": {"drivetrain_efficiency": 1.5}}, "vehicle.drivetrain_efficiency"),
-        ({"cargo_box": {"setpoint_c": 10}}, "cargo_box"),
-        ({"battery": {"initial_soc": 0.1, "min_soc": 0.2}}, "battery"),
+        ({"cargo_box": {"setpoint_c": 10}}, "cargo_box.product_limit_c"),
+        ({"battery": {"initial_soc": 0.1, "min_soc": 0.2}}, "battery.min_soc"),
         ({"date": "2026-13-45"}, "date"),
         ({"start_time": "25:00"}, "start_time"),
         ({"timezone": "Mars/Olympus"}, "timezone"),
         ({"objective": "fun"}, "objective"),
         ({"payload_kg": -1}, "payload_kg"),
-        ({"weather": {"t_min_c": 30, "t_max_c": 10}}, "weather"),
+        ({"weather": {"t_min_c": 30, "t_max_c": 10}}, "weather.t_max_c"),
+        (
+            {
+                "stops": [
+                    {"id": "A", "lat": 48.2, "lon": 16.3, "service_time_s": 60, "door_open_s": 90}
+                ]
+            },
+            "stops[0].door_open_s",
+        ),
         ({"matrix": {"distances_m": [[0]], "durations_s": [[0]]}}, "matrix.distances_m"),
         ({"unknown_field": 1}, "unknown_field"),
     ],

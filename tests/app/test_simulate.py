@@ -27,6 +27,19 @@ def test_trace_example_with_series(client):
     assert series["soc"][0] == 1.0 and series["soc"][-1] < 1.0
 
 
+def test_almost_standing_still_has_no_consumption_per_km(client):
+    body = client.post(
+        "/v1/simulate", json=SIMULATE_TRACE_EXAMPLE | {"speed_mps": [0, 1e-300, 0]}
+    ).json()
+    assert body["consumption_wh_per_km"] == {
+        "traction": None,
+        "auxiliaries": None,
+        "cabin": None,
+        "refrigeration": None,
+        "total": None,
+    }
+
+
 def test_standstill_has_no_consumption_per_km(client):
     body = client.post(
         "/v1/simulate", json=SIMULATE_TRACE_EXAMPLE | {"speed_mps": [0, 0, 0]}

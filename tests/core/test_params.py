@@ -56,8 +56,10 @@ def test_unknown_parameter_is_rejected():
 
 
 def test_cross_field_rules():
-    with pytest.raises(InvalidParameterError, match="min_soc must be below initial_soc"):
+    with pytest.raises(InvalidParameterError, match=r"min_soc must be at least 0\.01 below"):
         BatteryParams(initial_soc=0.2, min_soc=0.3)
+    with pytest.raises(InvalidParameterError, match=r"min_soc must be at least 0\.01 below"):
+        BatteryParams(initial_soc=0.5, min_soc=0.495)
     with pytest.raises(InvalidParameterError, match="t_min_c must not exceed t_max_c"):
         Weather(t_min_c=20, t_max_c=10)
     with pytest.raises(InvalidParameterError, match="product_limit_c must be above setpoint_c"):

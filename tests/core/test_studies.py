@@ -46,6 +46,8 @@ def test_sweep_rejects_bad_speeds():
     assert caught.value.field == "speeds_kmh[1]"
     with pytest.raises(InvalidParameterError):
         speed_sweep([], 10_000, NOON, VIENNA, VanParams(), HOT)
+    with pytest.raises(InvalidParameterError, match="at least 100 m"):
+        speed_sweep([40], 1e-300, NOON, VIENNA, VanParams(), HOT)
 
 
 def _round() -> PlanProblem:
