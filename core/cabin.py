@@ -1,21 +1,27 @@
-"""Auxiliaries and cabin comfort (paper §2.3, Table 2)."""
+"""Auxiliaries and cabin comfort (paper §2.3, Table 2), with the cab's thermal duty at stops."""
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core.arrays import FloatArray
+from core.arrays import FloatArray, interval_fraction, rate_integral
 from core.params import VehicleParams
 
 #: Paper Table 2: ambient temperature [°C] and the electric power [W] that keeps the cab at
 #: 20 °C (heating below 20 °C, air conditioning above).
 HVAC_TABLE_TEMPERATURE_C = np.array([-20.0, -10.0, 0.0, 10.0, 20.0, 30.0])
 HVAC_TABLE_POWER_W = np.array([4200.0, 3200.0, 2300.0, 900.0, 0.0, 600.0])
+#: The cab's comfort temperature [°C] (paper §2.3).
+CAB_SETPOINT_C = 20.0
+#: Share of the cab HVAC's power while parked, by ``cab_hvac_at_stops``.
+_PARKED_SHARE = {"on": 1.0, "off": 0.0}
 
 
 def cabin_hvac_power_w(vehicle: VehicleParams, ambient_c: ArrayLike) -> FloatArray:
-    """Electric power of the cab's heater / air conditioning [W] (paper Table 2).
+    """Electric power of the cab's heater / air conditioning holding 20 °C [W] (Table 2).
 
     Linear interpolation between the table's points, held flat outside -20…30 °C.
 
@@ -33,3 +39,106 @@ def cabin_hvac_power_w(vehicle: VehicleParams, ambient_c: ArrayLike) -> FloatArr
 def auxiliaries_power_w(vehicle: VehicleParams, n_steps: int) -> FloatArray:
     """Constant auxiliary power (radio, lights, controls) for ``n_steps`` steps [W] (§2.3)."""
     return np.full(n_steps, vehicle.auxiliaries_power_w)
+
+
+def parked_share(vehicle: VehicleParams) -> float:
+    """Share of the Table 2 power the cab HVAC draws while parked [–]."""
+    return _PARKED_SHARE.get(vehicle.cab_hvac_at_stops, vehicle.cab_reduced_share)
+
+
+def cab_deficit_j(
+    vehicle: VehicleParams, ambient_c: ArrayLike, parked_s: ArrayLike, initial_j: ArrayLike = 0.0
+) -> FloatArray:
+    """Electric energy to bring the cab back to 20 °C after parking [J].
+
+    A lumped cab loses heat to the outside with the conductance the Table 2 power implies,
+    ``G = P(ϑ_amb)/|20 °C − ϑ_amb|``, and has the recovery energy ``C`` per kelvin. Parked for
+    ``t`` with the HVAC at share ``s`` of ``P``, its deficit ``d`` [K] relaxes towards
+    ``(1 − s)·|20 − ϑ_amb|`` with the time constant ``C/G`` (first-order response), from
+    ``initial_j/C``; bringing it back costs ``C·d``.
+
+    Parameters
+    ----------
+    ambient_c
+        Outside temperature while parked [°C].
+    parked_s
+        How long the van stands [s]; ``inf`` for a cab that starts at the outside temperature.
+    initial_j
+        Deficit already there when the van parks [J] (a recovery not finished yet).
+    """
+    ambient = np.asarray(ambient_c, dtype=float)
+    gap_k = np.abs(CAB_SETPOINT_C - ambient)
+    power = cabin_hvac_power_w(vehicle, ambient)
+    capacity = vehicle.cab_recovery_energy_j_k
+    safe_gap = np.where(gap_k > 0.1, gap_k, 1.0)
+    rate = np.where(gap_k > 0.1, power / safe_gap / capacity, 0.0)
+    settled_j = capacity * (1.0 - parked_share(vehicle)) * gap_k * (power > 0)
+    keep = np.exp(-rate * np.asarray(parked_s, dtype=float))
+    return settled_j + (np.asarray(initial_j, dtype=float) - settled_j) * keep
+
+
+def cab_power_w(
+    vehicle: VehicleParams,
+    ambient_c: FloatArray,
+    step_end_s: FloatArray,
+    dt_s: float,
+    parked: Sequence[tuple[float, float]] = (),
+    initial_deficit_j: float = 0.0,
+) -> FloatArray:
+    """Electric power of the cab HVAC over each step [W] (Table 2 and the thermal duty).
+
+    While driving the HVAC holds 20 °C at the Table 2 power. While parked it draws the parked
+    share of it (``cab_hvac_at_stops``) and the cab drifts (:func:`cab_deficit_j`); once the van
+    drives on, the HVAC recovers the deficit with the power it has left below
+    ``cab_hvac_max_power_w``, as it does at departure for a cab that was not pre-conditioned
+    (``initial_deficit_j``). A recovery cut short by the next stop carries its rest into that
+    stop's drift. One pass over the stops; the per-second power is then one vectorised sum.
+
+    Parameters
+    ----------
+    ambient_c
+        Outside temperature of each step [°C].
+    step_end_s
+        End time of each step [s].
+    parked
+        ``(start_s, duration_s)`` of each stop, in time order.
+    initial_deficit_j
+        Energy to bring the cab to 20 °C at the start [J].
+    """
+    base = cabin_hvac_power_w(vehicle, ambient_c)
+    share = parked_share(vehicle)
+    nothing_parked = not parked or share == 1.0
+    if (
+        not vehicle.cabin_hvac_enabled
+        or base.size == 0
+        or (nothing_parked and initial_deficit_j == 0)
+    ):
+        return base
+    # At full power while parked the HVAC holds the cab as it does on the road: no stops count.
+    stops = [] if share == 1.0 else parked
+    starts = np.array([p[0] for p in stops], dtype=float)
+    durations = np.array([p[1] for p in stops], dtype=float)
+    power = base * (1.0 - (1.0 - share) * interval_fraction(starts, durations, step_end_s, dt_s))
+    ends = starts + durations
+    at_end = np.clip(np.searchsorted(step_end_s, ends), 0, base.size - 1)
+    spare = np.maximum(
+        vehicle.cab_hvac_max_power_w - base[at_end], 0.1 * vehicle.cab_hvac_max_power_w
+    )
+    boost_start, boost_end, boost_rate = [], [], []
+    deficit_j = initial_deficit_j
+    clock_s = float(step_end_s[0] - dt_s)
+    rate_w = max(vehicle.cab_hvac_max_power_w - float(base[0]), 0.1 * vehicle.cab_hvac_max_power_w)
+    for start_s, duration_s, end_s, ambient, spare_w in zip(
+        starts, durations, ends, ambient_c[at_end], spare, strict=True
+    ):
+        delivered_j = min(deficit_j, max(start_s - clock_s, 0.0) * rate_w)
+        boost_start.append(clock_s)
+        boost_end.append(clock_s + delivered_j / rate_w)
+        boost_rate.append(rate_w)
+        deficit_j = float(cab_deficit_j(vehicle, ambient, duration_s, deficit_j - delivered_j))
+        clock_s, rate_w = float(end_s), float(spare_w)
+    boost_start.append(clock_s)
+    boost_end.append(clock_s + deficit_j / rate_w)
+    boost_rate.append(rate_w)
+    edges = np.concatenate(([step_end_s[0] - dt_s], step_end_s))
+    return power + rate_integral(boost_start, boost_end, boost_rate, edges) / dt_s

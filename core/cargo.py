@@ -2,18 +2,20 @@
 
 Heat balance ``m·c_p·dϑ_CB/dt = Q_z − Q_0`` with ``Q_z = Q_α + Q_sol + Q_door`` (eqs 9, 10).
 In the paper's steady state the box stays at its set-point and the unit removes every load
-(``Q_0 = Q_z``). In dynamic mode the unit's capacity is finite and the box warms when the load
-exceeds it.
+(``Q_0 = Q_z``). In dynamic mode the unit's cooling and heating capacities are finite: the box
+warms (or cools) when the load exceeds them, and every load is taken at the box's current
+temperature, so the gain shrinks as the box warms.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core.arrays import FloatArray, reflected_cumsum
+from core.arrays import FloatArray
 from core.params import GRAVITY_MPS2, CargoBoxParams
 
 #: Specific gas constant of dry air [J/(kg·K)].
@@ -81,9 +83,57 @@ def door_heat_w(box: CargoBoxParams, ambient_c: ArrayLike, box_c: ArrayLike) -> 
 
 
 def heat_capacity_j_k(box: CargoBoxParams, payload_kg: ArrayLike) -> FloatArray:
-    """Thermal capacity of the box contents ``m·c_p`` [J/K] (eq. 9): cargo plus box air."""
+    """Thermal capacity of the box and its contents ``m·c_p`` [J/K] (eq. 9): cargo, box air and
+    the box structure that follows the air."""
     air = air_density_kg_m3(box.setpoint_c) * box.volume_m3 * AIR_SPECIFIC_HEAT_J_KGK
-    return np.asarray(payload_kg, dtype=float) * box.cargo_specific_heat_j_kgk + air
+    cargo = np.asarray(payload_kg, dtype=float) * box.cargo_specific_heat_j_kgk
+    return cargo + air + box.structure_heat_capacity_j_k
+
+
+#: Highest COP of the 'carnot' model [–]: small lifts (a cool day) cannot make the compressor
+#: arbitrarily efficient; its minimum pressure ratio and the fans bound it.
+MAX_CARNOT_COP = 6.0
+
+
+def refrigeration_cop(box: CargoBoxParams, ambient_c: ArrayLike, box_c: ArrayLike) -> FloatArray:
+    """Coefficient of performance of the unit when cooling [–] (η_RU of eq. 12).
+
+    'constant': the parameter ``cop`` (a scalar array). 'carnot': ``f·T_e/(T_c − T_e)`` with
+    the evaporator ``T_e = ϑ_box − ΔT_e`` and the condenser ``T_c = ϑ_amb + ΔT_c`` in kelvin
+    (the ideal vapour-compression limit scaled by the unit's Carnot fraction f; Stoecker & Jones,
+    *Refrigeration and Air Conditioning*, ch. 3), at most :data:`MAX_CARNOT_COP`.
+    """
+    ambient = np.asarray(ambient_c, dtype=float)
+    if box.cop_model == "constant":
+        return np.asarray(box.cop)
+    evaporator_k = np.asarray(box_c, dtype=float) - box.evaporator_approach_k + KELVIN_OFFSET
+    condenser_k = ambient + box.condenser_approach_k + KELVIN_OFFSET
+    lift_k = np.maximum(condenser_k - evaporator_k, 1e-9)
+    return np.minimum(box.carnot_fraction * evaporator_k / lift_k, MAX_CARNOT_COP)
+
+
+def door_conductance_w_k(box: CargoBoxParams, ambient_c: ArrayLike) -> FloatArray:
+    """Heat let in through the fully open door per kelvin between outside and box [W/K].
+
+    The Gosney–Olama flow at the set-point, ``Q_door(ϑ_amb, ϑ_set)/(ϑ_amb − ϑ_set)``; the flow
+    itself weakens as the difference shrinks, so using it at a warmer box errs on the safe
+    side.
+    """
+    ambient = np.asarray(ambient_c, dtype=float)
+    difference = ambient - box.setpoint_c
+    # Below 0.1 K the density difference vanishes, and so does the flow.
+    usable = np.abs(difference) > 0.1
+    safe = np.where(usable, difference, 1.0)
+    return np.where(usable, door_heat_w(box, ambient, box.setpoint_c) / safe, 0.0)
+
+
+def precondition_energy_j(box: CargoBoxParams, ambient_c: float) -> float:
+    """Electric energy to bring the box structure from the outside temperature to its
+    set-point [J]: cooling over the COP, or heating over the heating COP (no heater: 0)."""
+    heat_j = box.structure_heat_capacity_j_k * (ambient_c - box.setpoint_c)
+    if heat_j >= 0:
+        return heat_j / float(refrigeration_cop(box, ambient_c, box.setpoint_c))
+    return -heat_j / box.heating_cop if box.heater_enabled else 0.0
 
 
 @dataclass(frozen=True)
@@ -93,9 +143,9 @@ class BoxResult:
     Attributes
     ----------
     power_w
-        Electric power of the refrigeration unit and box heater [W] (eq. 12).
+        Electric power of the refrigeration unit, box heater and standby draw [W] (eq. 12).
     wall_heat_w, solar_heat_w, door_heat_w
-        Heat flows into the box [W] (eqs 11, 17, Gosney–Olama).
+        Heat flows into the box [W] (eqs 11, 17, Gosney–Olama), at the box's temperature.
     temperature_c
         Cargo-air temperature at the end of each step [°C].
     max_temperature_c
@@ -113,6 +163,12 @@ class BoxResult:
     minutes_above_limit: float
 
 
+#: Step of the dynamic box integration [s]: the box's time constant is many minutes even with
+#: the door open (an empty 8 m³ box: about 15 min), so 10 s steps of the exact exponential
+#: solution lose nothing and keep the Python loop short.
+BOX_STEP_S = 10.0
+
+
 def refrigeration(
     box: CargoBoxParams,
     ambient_c: FloatArray,
@@ -120,6 +176,7 @@ def refrigeration(
     door_open: FloatArray,
     payload_kg: ArrayLike,
     dt_s: float,
+    initial_c: float | None = None,
 ) -> BoxResult:
     """Heat loads and electric refrigeration power of every step (eqs 9–12).
 
@@ -137,36 +194,59 @@ def refrigeration(
         Cargo mass of each step [kg] (heat capacity in dynamic mode).
     dt_s
         Step length [s].
+    initial_c
+        Temperature of the box structure and air at the start [°C] (the cargo is loaded at the
+        set-point); None: everything at the set-point (pre-cooled at the depot).
 
     Notes
     -----
-    Steady mode (paper §4): ``Q_0 = max(Q_z, 0)``, ``P = Q_0/COP`` (eq. 12), plus ``−Q_z`` of
-    electric heating when the box loses heat and the heater is enabled.
+    Steady mode (paper §4): the loads at the set-point, ``Q_0 = max(Q_z, 0)``,
+    ``P = Q_0/COP`` (eq. 12), plus ``−Q_z/COP_heat`` when the box loses heat and the heater is
+    enabled, plus the standby draw. A box structure that starts warm is pulled down at the
+    unit's capacity from the start.
 
-    Dynamic mode: the heat stored above the set-point ``E = m·c_p·(ϑ_CB − ϑ_set)`` follows
-    ``E_k = max(0, E_{k−1} + (Q_z − Q_0,max)·Δt)``: an ideal thermostat runs the unit at full
-    capacity while the box is above its set-point and matches the load at the set-point. The
-    loads are evaluated at the set-point, which slightly overstates the warming (a warmer box
-    gains less through its walls), i.e. errs on the safe side for the product.
+    Dynamic mode: ``C·dϑ/dt = G·(ϑ_eq − ϑ) − Q_0`` with ``G = α·A + G_door`` and
+    ``ϑ_eq = ϑ_amb + Q_sol/G``, solved exactly over steps of :data:`BOX_STEP_S` with constant
+    inputs. An ideal thermostat runs the unit at full cooling capacity while the box is above
+    its set-point, at full heating capacity (if enabled) while below, and matches the load at
+    the set-point. The state is the temperature, so unloading cargo changes only the heat
+    capacity, never the temperature.
     """
     setpoint = box.setpoint_c
-    wall = wall_heat_w(box, ambient_c, setpoint)
-    door = np.zeros_like(wall)
+    door_conductance = np.zeros_like(ambient_c)
     is_open = door_open > 0
-    door[is_open] = door_heat_w(box, ambient_c[is_open], setpoint) * door_open[is_open]
-    load = wall + solar_heat + door
+    door_conductance[is_open] = door_open[is_open] * door_conductance_w_k(box, ambient_c[is_open])
     if box.mode == "steady":
-        removed = np.maximum(load, 0.0)
-        temperature = np.full_like(load, setpoint)
+        temperature = np.full_like(ambient_c, setpoint)
+        wall = wall_heat_w(box, ambient_c, setpoint)
+        door = door_conductance * (ambient_c - setpoint)
+        load = wall + solar_heat + door
+        if initial_c is not None:
+            pulldown_j = box.structure_heat_capacity_j_k * (initial_c - setpoint)
+            rate_w = box.refrigeration_capacity_w if pulldown_j > 0 else box.heating_capacity_w
+            load = load + _front_loaded(pulldown_j, rate_w, load.size, dt_s)
+        cooling = np.maximum(load, 0.0)
+        heating = np.maximum(-load, 0.0) if box.heater_enabled else 0.0
+        cop = refrigeration_cop(box, ambient_c, setpoint)
     else:
-        stored_j = reflected_cumsum((load - box.refrigeration_capacity_w) * dt_s)
-        previous_j = np.concatenate(([0.0], stored_j[:-1]))
-        removed = np.maximum(load - (stored_j - previous_j) / dt_s, 0.0)
-        temperature = setpoint + stored_j / heat_capacity_j_k(box, payload_kg)
-    heating = np.maximum(-load, 0.0) if box.heater_enabled else np.zeros_like(load)
+        capacity = heat_capacity_j_k(box, np.broadcast_to(payload_kg, ambient_c.shape))
+        if initial_c is None:
+            start_c = setpoint
+        else:
+            warm = capacity[0] - np.asarray(payload_kg, dtype=float).flat[0] * (
+                box.cargo_specific_heat_j_kgk
+            )
+            start_c = setpoint + warm / capacity[0] * (initial_c - setpoint)
+        temperature, cooling, heating = _integrate_box(
+            box, ambient_c, solar_heat, door_conductance, capacity, dt_s, start_c
+        )
+        wall = wall_heat_w(box, ambient_c, temperature)
+        door = door_conductance * (ambient_c - temperature)
+        cop = refrigeration_cop(box, ambient_c, temperature)
+    power = cooling / cop + heating / box.heating_cop + box.standby_power_w
     above = temperature > box.product_limit_c
     return BoxResult(
-        power_w=removed / box.cop + heating,
+        power_w=power,
         wall_heat_w=wall,
         solar_heat_w=solar_heat,
         door_heat_w=door,
@@ -174,3 +254,71 @@ def refrigeration(
         max_temperature_c=float(temperature.max()) if temperature.size else setpoint,
         minutes_above_limit=float(above.sum() * dt_s / 60.0),
     )
+
+
+def _front_loaded(energy_j: float, power_w: float, n_steps: int, dt_s: float) -> FloatArray:
+    """Per-step power [W] that delivers ``energy_j`` (signed) at ``power_w`` from the start."""
+    elapsed_j = np.arange(n_steps + 1) * dt_s * power_w
+    done = np.minimum(elapsed_j, abs(energy_j))
+    return np.sign(energy_j) * np.diff(done) / dt_s
+
+
+def _integrate_box(
+    box: CargoBoxParams,
+    ambient_c: FloatArray,
+    solar_heat: FloatArray,
+    door_conductance: FloatArray,
+    capacity_j_k: FloatArray,
+    dt_s: float,
+    start_c: float,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Box temperature at the end of each step [°C] and the heat removed and added in each
+    step [W], with the exact exponential solution over blocks of :data:`BOX_STEP_S`."""
+    n = ambient_c.size
+    per_block = max(round(BOX_STEP_S / dt_s), 1)
+    edges = np.arange(0, n, per_block)
+    counts = np.diff(np.append(edges, n))
+
+    def block_mean(values: FloatArray) -> list[float]:
+        return (np.add.reduceat(values, edges) / counts).tolist() if n else []
+
+    wall_g = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
+    ambient = block_mean(ambient_c)
+    solar = block_mean(solar_heat)
+    door_g = block_mean(door_conductance)
+    capacity = block_mean(capacity_j_k)
+    seconds = (counts * dt_s).tolist()
+    setpoint = box.setpoint_c
+    cool_w = box.refrigeration_capacity_w
+    heat_w = box.heating_capacity_w if box.heater_enabled else 0.0
+    ends, removed, added = [], [], []
+    t = start_c
+    for amb, sun, g_door, c, h in zip(ambient, solar, door_g, capacity, seconds, strict=True):
+        g = wall_g + g_door
+        equilibrium = amb + sun / g
+        decay = math.exp(-g * h / c)
+        free = equilibrium + (t - equilibrium) * decay
+        reach = (1.0 - decay) / g
+        cool_j = heat_j = 0.0
+        if free > setpoint:
+            end = max(free - cool_w * reach, setpoint)
+            cool_j = g * h * (equilibrium - 0.5 * (t + end)) - c * (end - t)
+            cool_j = min(max(cool_j, 0.0), cool_w * h)
+        elif free < setpoint and heat_w > 0:
+            end = min(free + heat_w * reach, setpoint)
+            heat_j = c * (end - t) - g * h * (equilibrium - 0.5 * (t + end))
+            heat_j = min(max(heat_j, 0.0), heat_w * h)
+        else:
+            end = free
+        ends.append(end)
+        removed.append(cool_j / h)
+        added.append(heat_j / h)
+        t = end
+    block_end = np.array(ends)
+    block_start = np.concatenate(([start_c], block_end[:-1]))
+    # Within a block, the temperature moves linearly from its start to its end.
+    position = (np.arange(n) - np.repeat(edges, counts) + 1) / np.repeat(counts, counts)
+    temperature = np.repeat(block_start, counts) + position * np.repeat(
+        block_end - block_start, counts
+    )
+    return temperature, np.repeat(removed, counts), np.repeat(added, counts)

@@ -156,6 +156,109 @@ def stretch_to_duration(speed_mps: FloatArray, dt_s: float, duration_s: float) -
     return stretched * (distance / total) if total > 0 else stretched
 
 
+#: Spacing of the distance grid on which a road speed profile is driven [m].
+PROFILE_GRID_M = 1.0
+#: Most grid points of one driven profile (beyond, the grid coarsens).
+_MAX_PROFILE_POINTS = 400_000
+#: Slowest and fastest speed a road segment may ask for [m/s] (a router's 0 or absurd speeds).
+_SEGMENT_SPEED_RANGE_MPS = (1.0, 60.0)
+
+
+def drive_profile(
+    segment_distance_m: FloatArray,
+    segment_speed_mps: FloatArray,
+    street: StreetType,
+    driver_aggressiveness: float,
+    max_acceleration_mps2: float,
+    traffic_density: float | None = None,
+    dt_s: float = 1.0,
+) -> tuple[FloatArray, FloatArray]:
+    """Drive a road's speed profile: a trace from rest to rest and the distance at each sample.
+
+    Each segment's speed (from a road router) is the target and the ceiling. The traffic's
+    slow-downs come on top: the trapezoid wave of ``street`` (paper §2.2; spaced along the road
+    at the leg's mean speed, denser with more traffic, ramps set by the driver) as a factor on
+    the target, capped at 1 — the router's free-flow speed is not exceeded. The van moves
+    between targets at ``max(ε_d, calm)·v̇_max``, braking ahead of slower segments and of the
+    end: on a 1 m distance grid the speed is the lowest of every target reachable from the
+    start or the end, ``v(s)² = min_j (v_j² + 2·a·|s − s_j|)``, with running minima (no loop).
+    Time follows from ``ds / v``; the trace is resampled every ``dt_s`` and scaled to cover
+    the road's distance exactly.
+
+    Parameters
+    ----------
+    segment_distance_m, segment_speed_mps
+        Length [m] and target speed [m/s] of each road segment, in driving order.
+    street
+        Street type whose wave the driver and traffic add.
+    driver_aggressiveness, max_acceleration_mps2, traffic_density, dt_s
+        As for :func:`generate_leg`.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Speed samples [m/s] every ``dt_s`` (first and last 0) and the distance driven at each
+        sample [m].
+    """
+    lengths = np.asarray(segment_distance_m, dtype=float)
+    targets = np.asarray(segment_speed_mps, dtype=float)
+    if lengths.ndim != 1 or lengths.shape != targets.shape:
+        raise InvalidParameterError(
+            "segment distances and speeds must be 1-D and of equal length", "segment_speed_mps"
+        )
+    if lengths.size == 0 or not np.all(np.isfinite(lengths) & (lengths >= 0)):
+        raise InvalidParameterError("segment distances must be finite and >= 0", "distance_m")
+    total = float(lengths.sum())
+    _check_leg_inputs(total, driver_aggressiveness, traffic_density, dt_s)
+    if total == 0:
+        return np.zeros(1), np.zeros(1)
+    low, high = _SEGMENT_SPEED_RANGE_MPS
+    moving = lengths > 0
+    mean_speed = float(
+        np.sum(lengths[moving])
+        / np.sum(
+            lengths[moving]
+            / np.clip(np.where(np.isfinite(targets[moving]), targets[moving], low), low, high)
+        )
+    )
+    targets = np.clip(np.where(np.isfinite(targets), targets, mean_speed), low, high)
+    if total / low / dt_s > MAX_LEG_SAMPLES:
+        raise LimitExceededError(f"a {total:g} m leg needs too many samples", "distance_m")
+
+    step_m = max(PROFILE_GRID_M, total / _MAX_PROFILE_POINTS)
+    grid = np.append(np.arange(0.0, total, step_m), total)
+    ends = np.cumsum(lengths)
+    segment = np.minimum(np.searchsorted(ends, grid, side="right"), lengths.size - 1)
+    target = targets[segment]
+
+    density = street.traffic_density if traffic_density is None else traffic_density
+    wave_street = street.model_copy(update={"mean_speed_mps": mean_speed})
+    wave_t, wave_v = _wave_breakpoints(
+        wave_street, driver_aggressiveness * max_acceleration_mps2, density, total / mean_speed
+    )
+    period_m = mean_speed * wave_t[-1]
+    slowdown = np.minimum(wave_v / mean_speed, 1.0)
+    target = target * np.interp(grid % period_m, wave_t * mean_speed, slowdown)
+
+    accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2
+    squared = target**2
+    squared[0] = squared[-1] = 0.0  # from rest, to rest
+    reach = 2.0 * accel * grid
+    forward = reach + np.minimum.accumulate(squared - reach)
+    backward = -reach + np.minimum.accumulate((squared + reach)[::-1])[::-1]
+    speed = np.sqrt(np.maximum(np.minimum(forward, backward), 0.0))
+
+    mean_cell = 0.5 * (speed[:-1] + speed[1:])
+    cell_s = np.diff(grid) / np.maximum(mean_cell, 1e-3)
+    clock = np.concatenate(([0.0], np.cumsum(cell_s)))
+    samples = np.arange(0.0, clock[-1] + dt_s, dt_s)
+    trace = np.interp(samples, clock, speed)
+    trace[-1] = 0.0
+    trace *= total / trace_distance_m(trace, dt_s)
+    travelled = np.concatenate(([0.0], np.cumsum(0.5 * (trace[:-1] + trace[1:]) * dt_s)))
+    return trace, travelled
+
+
 def _check_leg_inputs(
     distance_m: float, driver_aggressiveness: float, traffic_density: float | None, dt_s: float
 ) -> None:

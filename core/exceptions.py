@@ -36,5 +36,27 @@ class InvalidStopsError(CoreError):
     """The stops of a round are empty, duplicated or otherwise unusable."""
 
 
+class NoRouteError(InvalidStopsError):
+    """A road router finds no road between two places."""
+
+
 class LimitExceededError(CoreError):
     """An input is larger than the configured limit (stops, samples...)."""
+
+
+class ServiceUnavailableError(Exception):
+    """An outside service (road router, weather service) is down, too slow or answered
+    garbage. Not the client's fault: the web layer answers 503 naming ``service``.
+
+    Parameters
+    ----------
+    service
+        Which service (``"osrm"``, ``"weather"``).
+    message
+        What went wrong, for the operator.
+    """
+
+    def __init__(self, service: str, message: str) -> None:
+        super().__init__(message)
+        self.service = service
+        self.message = message

@@ -1,21 +1,26 @@
 """Legs between every ordered pair of places: distance, duration, street type and grade.
 
-Without a road router: great-circle distance times a detour factor, the street type by leg
-length and the duration from that street type's mean speed. A client may send its own road
-matrices instead; they are checked here.
+Three sources, in this order: the client's own road matrices (checked here), a road router's
+table (:class:`core.roads.RoadTable`), or the built-in estimate — great-circle distance times a
+detour factor, the street type by leg length and the duration from that street type's mean
+speed. With known durations the street type follows the leg's mean speed.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from core.arrays import FloatArray
 from core.exceptions import InvalidMatrixError
 from core.params import STREET_TYPES, Depot, RoadMatrix, StreetTypeName
+from core.roads import RoadTable
+
+DistanceSource = Literal["osrm", "client", "estimate"]
 
 #: Mean Earth radius [m] (IUGG, Moritz 2000).
 EARTH_RADIUS_M = 6_371_008.8
@@ -41,15 +46,18 @@ class Legs:
         Road distance [m], driving time [s] and mean grade [–] of each pair.
     street_type
         Index into :data:`STREET_TYPE_NAMES` of each pair.
-    from_client
-        Whether distances and durations came from the client's road router.
+    source
+        Where distances and durations came from.
+    snap_distance_m
+        Distance of each place from the road the router snapped it to [m]; None without one.
     """
 
     distance_m: FloatArray
     duration_s: FloatArray
     grade: FloatArray
     street_type: NDArray[np.int_]
-    from_client: bool
+    source: DistanceSource
+    snap_distance_m: FloatArray | None = None
 
     def street_type_name(self, i: int, j: int) -> StreetTypeName:
         """Street type of the leg from ``i`` to ``j``."""
@@ -79,7 +87,29 @@ def street_type_by_length(distance_m: FloatArray) -> NDArray[np.int_]:
     return np.searchsorted([URBAN_MAX_M, HIGHWAY_MAX_M], distance_m, side="left")
 
 
-def build_legs(places: Sequence[Depot], matrix: RoadMatrix | None = None) -> Legs:
+#: Mean speeds [m/s] from which a leg is highway, then expressway: 45 and 80 km/h, between the
+#: street types' mean speeds (30, 70, 100 km/h).
+STREET_SPEED_BOUNDS_MPS = (45 / 3.6, 80 / 3.6)
+
+
+def street_type_by_speed(distance_m: ArrayLike, duration_s: ArrayLike) -> NDArray[np.int_]:
+    """Street type index by a leg's mean speed; legs of no duration are urban.
+
+    Parameters
+    ----------
+    distance_m, duration_s
+        Distance [m] and driving time [s] of each leg.
+    """
+    distance = np.asarray(distance_m, dtype=float)
+    duration = np.asarray(duration_s, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        speed = np.where(duration > 0, distance / duration, 0.0)
+    return np.searchsorted(STREET_SPEED_BOUNDS_MPS, speed, side="right")
+
+
+def build_legs(
+    places: Sequence[Depot], matrix: RoadMatrix | None = None, table: RoadTable | None = None
+) -> Legs:
     """Distances, durations, street types and grades of every ordered pair of places.
 
     Parameters
@@ -87,21 +117,31 @@ def build_legs(places: Sequence[Depot], matrix: RoadMatrix | None = None) -> Leg
     places
         The depot first, then the stops.
     matrix
-        The client's road matrices in the same order, or None for the built-in estimate.
+        The client's road matrices in the same order; they win over everything.
+    table
+        A road router's table in the same order; used when there is no client matrix.
     """
     n = len(places)
     lat = np.array([p.lat for p in places])
     lon = np.array([p.lon for p in places])
-    if matrix is None:
+    source: DistanceSource
+    snap = None
+    if matrix is None and table is not None:
+        distance, duration = table.distance_m, table.duration_s
+        street = street_type_by_speed(distance, duration)
+        source, snap = "osrm", table.snap_distance_m
+    elif matrix is None:
         distance = great_circle_m(lat, lon) * DETOUR_FACTOR
         street = street_type_by_length(distance)
         speeds = np.array([STREET_TYPES[name].mean_speed_mps for name in STREET_TYPE_NAMES])
         duration = distance / speeds[street]
+        source = "estimate"
     else:
+        source = "client"
         distance = _checked_matrix(matrix.distances_m, "distances_m", n)
         duration = _checked_matrix(matrix.durations_s, "durations_s", n)
         if matrix.street_types is None:
-            street = street_type_by_length(distance)
+            street = street_type_by_speed(distance, duration)
         else:
             _check_shape(matrix.street_types, "street_types", n)
             street = np.array(
@@ -123,7 +163,8 @@ def build_legs(places: Sequence[Depot], matrix: RoadMatrix | None = None) -> Leg
         duration_s=duration,
         grade=np.clip(grade, -MAX_LEG_GRADE, MAX_LEG_GRADE),
         street_type=street,
-        from_client=matrix is not None,
+        source=source,
+        snap_distance_m=snap,
     )
 
 

@@ -114,6 +114,14 @@ class VehicleParams(Params):
     max_regen_power_w: float | None = Field(
         None, gt=0, le=1_000_000, description="Cap on regenerated electric power [W]; none if null."
     )
+    max_motor_power_w: float | None = Field(
+        None,
+        gt=0,
+        le=1_000_000,
+        description="Cap on the drive's mechanical power at the wheels [W]; none if null (the "
+        "paper's model). A trace that asks for more is followed as closely as the cap allows: "
+        "the van falls behind and catches up, so no energy is lost or invented.",
+    )
     max_acceleration_mps2: float = Field(
         2.0,
         ge=0.1,
@@ -131,6 +139,34 @@ class VehicleParams(Params):
     )
     cabin_hvac_enabled: bool = Field(
         True, description="Heat or cool the cab to 20 °C (paper Table 2); false switches it off."
+    )
+    cab_hvac_at_stops: Literal["on", "off", "reduced"] = Field(
+        "on",
+        description="Cab heating/air conditioning while parked at a stop: 'on' holds 20 °C (the "
+        "paper's assumption), 'off' lets the cab drift towards the outside air, 'reduced' runs at "
+        "cab_reduced_share of the power. After the stop the HVAC brings the cab back to 20 °C.",
+    )
+    cab_reduced_share: float = Field(
+        0.5,
+        ge=0,
+        le=1,
+        description="Share of the Table 2 power the cab HVAC draws while parked in 'reduced' [–].",
+    )
+    cab_recovery_energy_j_k: float = Field(
+        60_000.0,
+        gt=0,
+        le=1_000_000,
+        description="Electric energy to move the cab's temperature by one kelvin [J/K]: its "
+        "thermal mass (air ≈ 4 kJ/K plus seats, dashboard and trim) over a heater efficiency of "
+        "1. With the Table 2 power it sets how fast a parked cab drifts (time constant = this "
+        "value × |20 °C − outside| / Table 2 power).",
+    )
+    cab_hvac_max_power_w: float = Field(
+        6000.0,
+        gt=0,
+        le=50_000,
+        description="Most electric power of the cab HVAC [W]: how fast it brings the cab back "
+        "after a stop or a departure with a cold or hot cab.",
     )
 
 
@@ -164,8 +200,46 @@ class CargoBoxParams(Params):
         1.5,
         ge=0.1,
         le=10,
-        description="Coefficient of performance of the refrigeration unit η_RU [–] (eq. 12); 1.5 "
-        "is typical of small electric units at 30 °C ambient, chilled box.",
+        description="Coefficient of performance of the refrigeration unit η_RU [–] (eq. 12), "
+        "used when cop_model is 'constant'; 1.5 is typical of small electric units at 30 °C "
+        "ambient, chilled box.",
+    )
+    cop_model: Literal["constant", "carnot"] = Field(
+        "constant",
+        description="'constant': the paper's η_RU (cop). 'carnot': a fraction of the Carnot COP "
+        "between an evaporator below the box and a condenser above the outside air, so the unit "
+        "works harder on hot days and for frozen goods (see core.cargo.refrigeration_cop).",
+    )
+    carnot_fraction: float = Field(
+        0.3,
+        gt=0,
+        le=1,
+        description="Share of the Carnot COP the unit reaches [–] ('carnot' model). 0.3 is fitted "
+        "to the paper's η_RU = 1.5 at 30 °C outside / 4 °C box (COP 1.57) and gives 0.97 at "
+        "30 °C / −20 °C, within the 0.5–1.5 that Tassou, De-Lille & Ge (2009, Appl. Therm. Eng. "
+        "29) report for transport units.",
+    )
+    evaporator_approach_k: float = Field(
+        10.0, ge=0, le=40, description="Evaporator below the box air [K] ('carnot' model)."
+    )
+    condenser_approach_k: float = Field(
+        15.0, ge=0, le=40, description="Condenser above the outside air [K] ('carnot' model)."
+    )
+    standby_power_w: float = Field(
+        0.0,
+        ge=0,
+        le=5000,
+        description="Draw of the unit's controls and evaporator fans whenever it runs [W]; 0 in "
+        "the paper.",
+    )
+    structure_heat_capacity_j_k: float = Field(
+        190_000.0,
+        gt=0,
+        le=10_000_000,
+        description="Heat capacity of the box structure that follows the cargo air [J/K]: the "
+        "inner GRP liner (2 mm, 1850 kg/m³, 1000 J/(kg·K)) and half the polyurethane foam "
+        "(80 mm, 40 kg/m³, 1500 J/(kg·K)) over the 30.6 m² of the paper's box ≈ 187 kJ/K. "
+        "Dynamic mode, and the pull-down of a box that was not pre-cooled.",
     )
     solar_absorptivity: float = Field(
         0.3,
@@ -224,8 +298,21 @@ class CargoBoxParams(Params):
     )
     heater_enabled: bool = Field(
         False,
-        description="When the box loses heat (cold day), heat it electrically (efficiency 1) to "
-        "hold the set-point. The paper's van has no heater.",
+        description="When the box loses heat (outside colder than the set-point), heat it to hold "
+        "the set-point (chilled produce must not freeze). The paper's van has no heater.",
+    )
+    heating_cop: float = Field(
+        1.0,
+        ge=0.5,
+        le=6,
+        description="Heat delivered per electric energy when the box is heated [–]: 1 for an "
+        "electric or hot-gas heater, 2–3 for a reversible heat pump.",
+    )
+    heating_capacity_w: float = Field(
+        2000.0,
+        gt=0,
+        le=100_000,
+        description="Most heat the box heater delivers [W] (dynamic mode only).",
     )
 
     @field_validator("product_limit_c")
@@ -257,6 +344,19 @@ class BatteryParams(Params):
     min_soc: float = Field(
         0.1, ge=0, lt=1, description="Reserve: lowest acceptable state of charge [–]."
     )
+    temperature_derating: bool = Field(
+        False,
+        description="Derate the battery in cold and heat: less usable energy and more energy per "
+        "km of every consumer, from AAA's 2019 dynamometer tests of five EVs with HVAC off "
+        "(see core.battery). False: the paper's temperature-independent battery.",
+    )
+    charging_efficiency: float = Field(
+        0.9,
+        ge=0.5,
+        le=1,
+        description="Energy stored per energy drawn from the grid when charging [–]; sets the "
+        "energy to recharge at the plug.",
+    )
 
     @field_validator("min_soc")
     @classmethod
@@ -287,10 +387,16 @@ class Location(Params):
     lon: float = Field(..., ge=-180, le=180, description="Longitude [°], east positive.")
 
 
-class DoorOpening(Params):
-    """One opening of the cargo door during a simulated trace."""
+class Interval(Params):
+    """A span of time within a simulated trace."""
 
     start_s: float = Field(..., ge=0, description="Start, seconds after the trace start [s].")
+    duration_s: float = Field(..., ge=0, le=86_400, description="How long it lasts [s].")
+
+
+class DoorOpening(Interval):
+    """One opening of the cargo door during a simulated trace."""
+
     duration_s: float = Field(..., ge=0, le=86_400, description="How long it stays open [s].")
 
 
@@ -340,6 +446,13 @@ class VanParams(Params):
     payload_kg: float = Field(
         550.0, ge=0, le=40_000, description="Payload at departure [kg] (Table 1: 550 kg)."
     )
+    precondition_at_depot: bool = Field(
+        True,
+        description="Bring the cab to 20 °C and the box structure to its set-point on grid power "
+        "before departure (reported as grid_kwh, not taken from the battery). False: the van "
+        "leaves with the cab and the box structure at the outside temperature and the battery "
+        "pays for the pull-down.",
+    )
 
 
 class Preset(VanParams):
@@ -378,6 +491,52 @@ PRESETS: dict[str, Preset] = {
         ),
         battery=BatteryParams(usable_capacity_kwh=52.0),
         payload_kg=0.0,
+    ),
+    "ev-van-3.5t-reefer": Preset(
+        name="ev-van-3.5t-reefer",
+        description="A 3.5 t battery-electric large panel van converted to a chilled reefer, from "
+        "published data of the class (68 kWh usable, 317 km WLTP, 135 kW motor; high roof, drag "
+        "area c_d·A_f = 0.34 × 4.5 m²; light-truck tyres of EU label class B, c_r 0.0065): "
+        "2,900 kg with driver, insulation kit and unit (the bare van's WLTP test mass is about "
+        "2,450 kg), 500 kg payload; a 9.5 m³ ATP 'IR' box (K = 0.35 W/(m²·K) ≤ 0.4) with an "
+        "inverter-driven electric unit (2.5 kW cooling, 1.5 kW heating, 150 W standby, COP a "
+        "Carnot fraction), strip curtain; cab HVAC off at stops; battery derated in the cold; "
+        "pre-conditioned at the depot. Validated in tests/core/test_presets.py: WLTC 3b at the "
+        "plug 215–250 Wh/km, refrigeration 1–3 kW at 30 °C / 4 °C, 10 min of open door ≈ 2 h "
+        "of wall gain.",
+        vehicle=VehicleParams(
+            mass_kg=2900.0,
+            drag_coefficient=0.34,
+            frontal_area_m2=4.5,
+            rolling_resistance_coefficient=0.0065,
+            rolling_resistance_factor=1.0,
+            drivetrain_efficiency=0.9,
+            regen_efficiency=0.8,
+            max_regen_power_w=70_000.0,
+            max_motor_power_w=135_000.0,
+            max_acceleration_mps2=1.8,
+            auxiliaries_power_w=400.0,
+            cab_hvac_at_stops="off",
+        ),
+        cargo_box=CargoBoxParams(
+            volume_m3=9.5,
+            wall_heat_transfer_w_m2k=0.35,
+            roof_area_m2=5.6,
+            side_area_m2=5.8,
+            back_area_m2=2.8,
+            door_width_m=1.4,
+            door_height_m=1.6,
+            curtain_effectiveness=0.4,
+            mode="dynamic",
+            refrigeration_capacity_w=2500.0,
+            cop_model="carnot",
+            standby_power_w=150.0,
+            structure_heat_capacity_j_k=173_000.0,
+            heater_enabled=True,
+            heating_capacity_w=1500.0,
+        ),
+        battery=BatteryParams(usable_capacity_kwh=68.0, temperature_derating=True),
+        payload_kg=500.0,
     ),
 }
 DEFAULT_PRESET = "paper-generic"

@@ -1,9 +1,11 @@
 """A delivery round from depot, stops and date to a simulated round trip (paper §4, Fig. 7).
 
-1. legs between every ordered pair (:mod:`core.geo`); 2. the tour (:mod:`core.tsp`) on the
-chosen objective; 3. the day's timeline — depart, drive each leg (a generated speed trace),
-arrive, open the door within the service time, unload (the payload and so the mass drop), go
-on, return; 4. one vectorised simulation of the whole day (:func:`core.simulate.simulate`),
+1. legs between every ordered pair (:mod:`core.geo`: the client's matrix, a road router's table
+or the estimate); 2. the tour (:mod:`core.tsp`) on the chosen objective; 3. the day's timeline —
+depart, drive each leg (the router's road speed profile, or a generated trace), arrive, park,
+open the door within the service time, unload (the payload and so the mass drop), go on,
+return; 4. the weather for the round's span (a forecast service, the request, or the
+climatology); 5. one vectorised simulation of the whole day (:func:`core.simulate.simulate`),
 split per leg and per stop.
 """
 
@@ -13,7 +15,6 @@ import datetime as dt
 import itertools
 import math
 from dataclasses import dataclass
-from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,14 +22,28 @@ from pydantic import Field
 
 from core.arrays import FloatArray
 from core.battery import JOULES_PER_KWH, BatteryVerdict
-from core.cycles import generate_leg, stretch_to_duration, trace_distance_m
-from core.exceptions import InvalidParameterError, InvalidStopsError, LimitExceededError
-from core.geo import MAX_LEG_GRADE, STREET_TYPE_NAMES, Legs, build_legs
+from core.clock import UTC, at, check_representable, departure
+from core.cycles import drive_profile, generate_leg, stretch_to_duration, trace_distance_m
+from core.exceptions import (
+    InvalidStopsError,
+    LimitExceededError,
+    NoRouteError,
+    ServiceUnavailableError,
+)
+from core.geo import (
+    MAX_LEG_GRADE,
+    STREET_TYPE_NAMES,
+    DistanceSource,
+    Legs,
+    build_legs,
+    street_type_by_speed,
+)
 from core.params import (
     NORMAL_DRIVER,
     STREET_TYPES,
     Depot,
     DoorOpening,
+    Interval,
     Location,
     Objective,
     Params,
@@ -38,10 +53,11 @@ from core.params import (
     VanParams,
     Weather,
 )
+from core.roads import LegRoute, RoadRouter, WeatherService, bearing_deg
 from core.simulate import CONSUMERS, SimulationResult, simulate
 from core.tsp import SolverStatus, solve_tour
 from core.vehicle import step_traction_power_w
-from core.weather import WeatherSource
+from core.weather import DayWeather, Forecast, WeatherSource
 
 #: Sampling interval of the day's simulation [s].
 PLAN_DT_S = 1.0
@@ -73,7 +89,11 @@ class PlanProblem(Params):
 
 @dataclass(frozen=True)
 class LegResult:
-    """One driven leg of the round."""
+    """One driven leg of the round.
+
+    ``geometry`` is the road as ``(lon, lat)`` points: the router's polyline, or the straight
+    line between the two places when the distances are an estimate or the client's.
+    """
 
     from_id: str
     to_id: str
@@ -86,6 +106,7 @@ class LegResult:
     energy_kwh: dict[str, float]
     soc_start: float
     soc_end: float
+    geometry: list[tuple[float, float]]
 
 
 @dataclass(frozen=True)
@@ -100,6 +121,9 @@ class StopResult:
     energy_kwh: dict[str, float]
     soc_arrival: float
     soc_departure: float
+    snap_distance_m: float | None
+    lat: float
+    lon: float
 
 
 #: Spacing of the day profile's points [s].
@@ -134,12 +158,18 @@ class PlanResult:
     energy_kwh: dict[str, float]
     energy_share: dict[str, float]
     battery: BatteryVerdict
+    battery_loss_kwh: float
+    grid_kwh: float
     first_infeasible_leg: int | None
     max_box_temperature_c: float | None
     minutes_above_product_limit: float | None
     weather: Weather
+    weather_days: list[DayWeather]
     weather_source: WeatherSource
+    warnings: list[str]
     timezone: str
+    distance_source: DistanceSource
+    depot_snap_distance_m: float | None
     solver_status: SolverStatus
     objective: Objective
     objective_value: float
@@ -147,14 +177,34 @@ class PlanResult:
     profile: DayProfile
 
 
-def plan(problem: PlanProblem) -> PlanResult:
-    """Solve the round trip on the chosen objective and simulate it in full (paper Fig. 7)."""
+def plan(
+    problem: PlanProblem,
+    router: RoadRouter | None = None,
+    weather_service: WeatherService | None = None,
+) -> PlanResult:
+    """Solve the round trip on the chosen objective and simulate it in full (paper Fig. 7).
+
+    Parameters
+    ----------
+    problem
+        The round.
+    router
+        A road router for the distance matrix and the legs' roads; used unless the problem
+        carries the client's own matrix. Its failures propagate
+        (:class:`core.exceptions.ServiceUnavailableError`): a plan is never silently made on
+        estimated roads when real ones were asked for.
+    weather_service
+        An hourly forecast for the round's span; used unless the problem carries its own
+        weather. When it fails the round is planned on the climatology and ``warnings`` says
+        so.
+    """
     _check_stops(problem)
     start, timezone_name = departure(
         problem.date, problem.start_time, problem.timezone, problem.depot.lon
     )
     places: list[Depot] = [problem.depot, *problem.stops]
-    legs = build_legs(places, problem.matrix)
+    table = router.table(places) if router is not None and problem.matrix is None else None
+    legs = build_legs(places, problem.matrix, table)
     cost, unit_value, offset = _cost_matrix(problem, legs, start)
     tour = solve_tour(cost, problem.time_limit_s, problem.keep_order)
     order = tour.order
@@ -168,18 +218,24 @@ def plan(problem: PlanProblem) -> PlanResult:
             "stops",
         )
     objective_value = tour.cost * unit_value + offset * (len(order) - 1)
-
-    speed, grade, payload, doors, marks = _timeline(problem, legs, order)
+    routes = (
+        _routes(router, places, order) if router is not None and legs.source == "osrm" else None
+    )
+    timeline = _timeline(problem, places, legs, order, routes)
+    check_representable(start, timeline.speed.size * PLAN_DT_S, "date")
+    weather, warnings = _weather(problem, weather_service, start, timeline.speed.size * PLAN_DT_S)
     result = simulate(
-        speed,
+        timeline.speed,
         PLAN_DT_S,
         start,
         Location(lat=problem.depot.lat, lon=problem.depot.lon),
         problem.van,
-        grade=grade,
-        payload_kg=payload,
-        weather=problem.weather,
-        door_openings=doors,
+        grade=timeline.grade,
+        payload_kg=timeline.payload,
+        weather=weather,
+        door_openings=timeline.doors,
+        parked=timeline.parked,
+        heading_deg=timeline.heading,
     )
     return _assemble(
         problem,
@@ -187,13 +243,52 @@ def plan(problem: PlanProblem) -> PlanResult:
         legs,
         order,
         result,
-        marks,
+        timeline,
         start,
         timezone_name,
         tour.status,
         objective_value,
         tour.runtime_s,
+        warnings,
     )
+
+
+def _routes(router: RoadRouter, places: list[Depot], order: list[int]) -> list[LegRoute]:
+    """The router's road of every leg of the tour; a leg with no road names its destination."""
+    routes = []
+    for i, j in itertools.pairwise(order):
+        try:
+            routes.append(router.route(places[i], places[j]))
+        except NoRouteError as error:
+            raise NoRouteError(error.message, _place_field(j)) from None
+    return routes
+
+
+def _place_field(index: int) -> str:
+    """The request field of place ``index`` (0 the depot)."""
+    return "depot" if index == 0 else f"stops[{index - 1}]"
+
+
+def _weather(
+    problem: PlanProblem, service: WeatherService | None, start: dt.datetime, span_s: float
+) -> tuple[Forecast | None, list[str]]:
+    """The request's weather, else the service's forecast for the span, else None (the
+    climatology) with a warning when the service failed."""
+    if problem.weather is not None or service is None:
+        return problem.weather, []
+    begin = start.astimezone(UTC)
+    try:
+        return (
+            service.hourly(
+                problem.depot.lat, problem.depot.lon, begin, begin + dt.timedelta(seconds=span_s)
+            ),
+            [],
+        )
+    except ServiceUnavailableError as error:
+        return None, [
+            f"weather service unavailable ({error.message}); planned on the climatology for "
+            "the date and latitude"
+        ]
 
 
 def _check_stops(problem: PlanProblem) -> None:
@@ -215,29 +310,6 @@ def _check_stops(problem: PlanProblem) -> None:
         )
 
 
-def departure(
-    date: dt.date, start_time: dt.time, timezone: str | None, lon: float
-) -> tuple[dt.datetime, str]:
-    """Departure time with its zone, and the zone's name; with no IANA zone, local mean solar
-    time at longitude ``lon`` [°] (UTC offset lon/15 h)."""
-    if timezone is None:
-        offset = dt.timedelta(minutes=round(lon * 4))
-        zone: dt.tzinfo = dt.timezone(offset)
-        minutes = abs(int(offset.total_seconds() // 60))
-        sign = "+" if offset >= dt.timedelta(0) else "-"
-        name = f"local mean solar time (UTC{sign}{minutes // 60:02d}:{minutes % 60:02d})"
-    else:
-        try:
-            zone = ZoneInfo(timezone)
-        except (ZoneInfoNotFoundError, ValueError):
-            raise InvalidParameterError(
-                f"unknown time zone '{timezone}'; use an IANA name like Europe/Vienna",
-                "timezone",
-            ) from None
-        name = timezone
-    return dt.datetime.combine(date, start_time, tzinfo=zone), name
-
-
 def _constant_power_w(problem: PlanProblem, start: dt.datetime) -> float:
     """Auxiliaries + cab + box power at departure, standing [W]: the energy objective's time
     cost."""
@@ -246,7 +318,7 @@ def _constant_power_w(problem: PlanProblem, start: dt.datetime) -> float:
         PLAN_DT_S,
         start,
         Location(lat=problem.depot.lat, lon=problem.depot.lon),
-        problem.van,
+        problem.van.model_copy(update={"precondition_at_depot": True}),
         weather=problem.weather,
     )
     return float(sum(standing.power_w[name][0] for name in CONSUMERS if name != "traction"))
@@ -259,8 +331,9 @@ def _energy_matrix_j(problem: PlanProblem, legs: Legs, start: dt.datetime) -> Fl
     driver, traffic and departure mass) at every grade of a table from −25 % to +25 % in one
     broadcast call, and read for each leg by interpolation in its grade: climbs cost over the
     drive-train efficiency, descents first replace motoring and only then regenerate, and the
-    matrix is asymmetric. Auxiliaries, cab and box add their power at departure times the leg's
-    duration. The chosen tour is then simulated in full.
+    matrix is asymmetric. Auxiliaries, cab and box add their power at departure (the request's
+    weather or the climatology) times the leg's duration. The chosen tour is then simulated in
+    full.
     """
     vehicle = problem.van.vehicle
     mass = vehicle.mass_kg + problem.van.payload_kg
@@ -305,64 +378,128 @@ def _cost_matrix(
 
 
 @dataclass(frozen=True)
-class _Marks:
-    """Sample indices of the timeline: leg k drives from depart[k] to arrive[k]; the stop after
-    it (if any) lasts until leave[k]."""
+class _Timeline:
+    """The day sample by sample, and the marks that split it: leg k drives from depart[k] to
+    arrive[k]; the stop after it (if any) lasts until leave[k]."""
 
+    speed: FloatArray
+    grade: FloatArray
+    payload: FloatArray
+    heading: FloatArray
+    doors: list[DoorOpening]
+    parked: list[Interval]
     depart: NDArray[np.int_]
     arrive: NDArray[np.int_]
     leave: NDArray[np.int_]
+    street_types: list[StreetTypeName]
+    geometry: list[list[tuple[float, float]]]
 
 
-def _timeline(
-    problem: PlanProblem, legs: Legs, order: list[int]
-) -> tuple[FloatArray, FloatArray, FloatArray, list[DoorOpening], _Marks]:
-    """Speed, grade and payload of every sample of the day, the door openings and the marks."""
+def _drive(
+    problem: PlanProblem,
+    legs: Legs,
+    i: int,
+    j: int,
+    route: LegRoute | None,
+    straight_heading_deg: float,
+) -> tuple[FloatArray, FloatArray, StreetTypeName]:
+    """Speed trace, heading of each sample and street type of the leg from i to j."""
     vehicle = problem.van.vehicle
-    speed_parts: list[FloatArray] = [np.zeros(1)]
-    grade_parts: list[FloatArray] = [np.zeros(1)]
-    payload_parts: list[FloatArray] = [np.array([problem.van.payload_kg])]
-    doors: list[DoorOpening] = []
-    depart, arrive, leave = [], [], []
-    clock = 0
-    payload = problem.van.payload_kg
-    for i, j in itertools.pairwise(order):
+    if route is None:
+        street_type = legs.street_type_name(i, j)
         trace = generate_leg(
             float(legs.distance_m[i, j]),
-            STREET_TYPES[legs.street_type_name(i, j)],
+            STREET_TYPES[street_type],
             problem.driver_aggressiveness,
             vehicle.max_acceleration_mps2,
             problem.traffic_density,
             PLAN_DT_S,
         )
-        if legs.from_client:
+        if legs.source == "client":
             trace = stretch_to_duration(trace, PLAN_DT_S, float(legs.duration_s[i, j]))
+        return trace, np.full(trace.size, straight_heading_deg), street_type
+    free_flow_s = float(np.sum(route.segment_distance_m / route.segment_speed_mps))
+    street_type = STREET_TYPE_NAMES[int(street_type_by_speed(route.distance_m, free_flow_s))]
+    trace, travelled = drive_profile(
+        route.segment_distance_m,
+        route.segment_speed_mps,
+        STREET_TYPES[street_type],
+        problem.driver_aggressiveness,
+        vehicle.max_acceleration_mps2,
+        problem.traffic_density,
+        PLAN_DT_S,
+    )
+    ends = np.cumsum(route.segment_distance_m)
+    segment = np.minimum(np.searchsorted(ends, travelled), ends.size - 1)
+    return trace, route.segment_heading_deg[segment], street_type
+
+
+def _timeline(
+    problem: PlanProblem,
+    places: list[Depot],
+    legs: Legs,
+    order: list[int],
+    routes: list[LegRoute] | None,
+) -> _Timeline:
+    """Speed, grade, payload and heading of every sample of the day, the door openings, the
+    stops and the marks."""
+    speed_parts: list[FloatArray] = [np.zeros(1)]
+    grade_parts: list[FloatArray] = [np.zeros(1)]
+    heading_parts: list[FloatArray] = [np.full(1, np.nan)]
+    payload_parts: list[FloatArray] = [np.array([problem.van.payload_kg])]
+    doors: list[DoorOpening] = []
+    parked: list[Interval] = []
+    depart, arrive, leave = [], [], []
+    street_types: list[StreetTypeName] = []
+    geometry: list[list[tuple[float, float]]] = []
+    clock = 0
+    payload = problem.van.payload_kg
+    for k, (i, j) in enumerate(itertools.pairwise(order)):
+        a, b = places[i], places[j]
+        route = routes[k] if routes is not None else None
+        trace, heading, street_type = _drive(
+            problem, legs, i, j, route, bearing_deg(a.lat, a.lon, b.lat, b.lon)
+        )
+        street_types.append(street_type)
+        geometry.append(
+            [(float(x), float(y)) for x, y in route.coordinates]
+            if route is not None
+            else [(a.lon, a.lat), (b.lon, b.lat)]
+        )
         drive = trace[1:]
         depart.append(clock)
         clock += drive.size
         arrive.append(clock)
         speed_parts.append(drive)
+        heading_parts.append(heading[1:])
         grade_parts.append(np.full(drive.size, legs.grade[i, j]))
         payload_parts.append(np.full(drive.size, payload))
         if j != 0:
             stop = problem.stops[j - 1]
             dwell = math.ceil(stop.service_time_s / PLAN_DT_S)
+            parked.append(Interval(start_s=clock * PLAN_DT_S, duration_s=dwell * PLAN_DT_S))
             if stop.door_open_s > 0:
                 doors.append(DoorOpening(start_s=clock * PLAN_DT_S, duration_s=stop.door_open_s))
             payload = max(payload - stop.delivery_kg, 0.0)
             speed_parts.append(np.zeros(dwell))
             grade_parts.append(np.zeros(dwell))
+            heading_parts.append(np.full(dwell, np.nan))
             # Unloading happens during the stop: the lighter van drives away.
             payload_parts.append(np.full(dwell, payload))
             clock += dwell
         leave.append(clock)
-    marks = _Marks(np.array(depart), np.array(arrive), np.array(leave))
-    return (
-        np.concatenate(speed_parts),
-        np.concatenate(grade_parts),
-        np.concatenate(payload_parts),
-        doors,
-        marks,
+    return _Timeline(
+        speed=np.concatenate(speed_parts),
+        grade=np.concatenate(grade_parts),
+        payload=np.concatenate(payload_parts),
+        heading=np.concatenate(heading_parts),
+        doors=doors,
+        parked=parked,
+        depart=np.array(depart),
+        arrive=np.array(arrive),
+        leave=np.array(leave),
+        street_types=street_types,
+        geometry=geometry,
     )
 
 
@@ -379,12 +516,13 @@ def _assemble(
     legs: Legs,
     order: list[int],
     result: SimulationResult,
-    marks: _Marks,
+    timeline: _Timeline,
     start: dt.datetime,
     timezone_name: str,
     status: SolverStatus,
     objective_value: float,
     runtime_s: float,
+    warnings: list[str],
 ) -> PlanResult:
     cumulative = {
         name: np.concatenate(([0.0], np.cumsum(power) * PLAN_DT_S))
@@ -392,27 +530,29 @@ def _assemble(
     }
     door_cumulative = np.concatenate(([0.0], np.cumsum(result.box.door_heat_w) * PLAN_DT_S))
     soc = result.soc
+    snap = legs.snap_distance_m
 
-    def at(sample: int) -> dt.datetime:
-        return start + dt.timedelta(seconds=float(sample) * PLAN_DT_S)
+    def moment(sample: int) -> dt.datetime:
+        return at(start, float(sample) * PLAN_DT_S)
 
     leg_results, stop_results = [], []
     payload = problem.van.payload_kg
     for k, (i, j) in enumerate(itertools.pairwise(order)):
-        a, b, c = int(marks.depart[k]), int(marks.arrive[k]), int(marks.leave[k])
+        a, b, c = int(timeline.depart[k]), int(timeline.arrive[k]), int(timeline.leave[k])
         leg_results.append(
             LegResult(
                 from_id=places[i].id,
                 to_id=places[j].id,
-                depart=at(a),
-                arrive=at(b),
+                depart=moment(a),
+                arrive=moment(b),
                 distance_m=trace_distance_m(result.speed_mps[a : b + 1], PLAN_DT_S),
                 duration_s=(b - a) * PLAN_DT_S,
-                street_type=legs.street_type_name(i, j),
+                street_type=timeline.street_types[k],
                 grade=float(legs.grade[i, j]),
                 energy_kwh=_span_kwh(cumulative, a, b),
                 soc_start=float(soc[a]),
                 soc_end=float(soc[b]),
+                geometry=timeline.geometry[k],
             )
         )
         if j != 0:
@@ -420,13 +560,16 @@ def _assemble(
             stop_results.append(
                 StopResult(
                     id=places[j].id,
-                    arrival=at(b),
-                    departure=at(c),
+                    arrival=moment(b),
+                    departure=moment(c),
                     door_heat_kwh=float(door_cumulative[c] - door_cumulative[b]) / JOULES_PER_KWH,
                     payload_after_kg=payload,
                     energy_kwh=_span_kwh(cumulative, b, c),
                     soc_arrival=float(soc[b]),
                     soc_departure=float(soc[c]),
+                    snap_distance_m=None if snap is None else float(snap[j]),
+                    lat=places[j].lat,
+                    lon=places[j].lon,
                 )
             )
     total = result.energy_kwh["total"]
@@ -447,17 +590,25 @@ def _assemble(
             name: (result.energy_kwh[name] / total if total > 0 else 0.0) for name in CONSUMERS
         },
         battery=result.battery,
+        battery_loss_kwh=result.battery_loss_kwh,
+        grid_kwh=result.grid_kwh,
         first_infeasible_leg=(
-            None if first_bad is None else int(np.searchsorted(marks.leave, first_bad, side="left"))
+            None
+            if first_bad is None
+            else int(np.searchsorted(timeline.leave, first_bad, side="left"))
         ),
         max_box_temperature_c=result.box.max_temperature_c if dynamic else None,
         minutes_above_product_limit=result.box.minutes_above_limit if dynamic else None,
         weather=result.weather,
+        weather_days=result.weather_days,
         weather_source=result.weather_source,
+        warnings=warnings,
         timezone=timezone_name,
+        distance_source=legs.source,
+        depot_snap_distance_m=None if snap is None else float(snap[0]),
         solver_status=status,
         objective=problem.objective,
         objective_value=objective_value,
         solver_runtime_s=runtime_s,
-        profile=DayProfile([at(int(i)) for i in picks], profile_kwh),
+        profile=DayProfile([moment(int(i)) for i in picks], profile_kwh),
     )

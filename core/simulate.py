@@ -1,8 +1,8 @@
 """One speed trace in, per-consumer power, energy and state of charge out.
 
 Everything is computed over the whole time grid at once with numpy; there is no Python loop
-per time step. A trace of ``n`` samples has ``n − 1`` steps; per-step arrays hold the mean
-power over each step.
+per time step (the dynamic cargo box steps every 10 s, :mod:`core.cargo`). A trace of ``n``
+samples has ``n − 1`` steps; per-step arrays hold the mean power over each step.
 """
 
 from __future__ import annotations
@@ -12,30 +12,34 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from core import battery as battery_model
-from core.arrays import FloatArray
-from core.cabin import auxiliaries_power_w, cabin_hvac_power_w
-from core.cargo import BoxResult, refrigeration
+from core.arrays import FloatArray, interval_fraction
+from core.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
+from core.cargo import BoxResult, precondition_energy_j, refrigeration
+from core.clock import SECONDS_PER_DAY, check_representable, local_clock
 from core.cycles import trace_distance_m
 from core.exceptions import InvalidParameterError
-from core.params import DoorOpening, Location, VanParams, Weather
+from core.params import DoorOpening, Interval, Location, VanParams, Weather
 from core.solar import (
     absorbed_solar_heat_w,
     declination_deg,
+    direct_irradiance_w_m2,
+    direct_normal_from_horizontal_w_m2,
     equation_of_time_min,
     sin_altitude,
     solar_time_h,
 )
 from core.vehicle import step_traction_power_w
-from core.weather import WeatherSource, daily_temperature_c, resolve_weather
+from core.weather import Conditions, DayWeather, Forecast, WeatherSource, conditions, headwind_mps
 
 CONSUMERS = ("traction", "auxiliaries", "cabin", "refrigeration")
 #: Highest speed a trace may hold [m/s] (250 km/h): anything faster is a unit mistake.
 MAX_SPEED_MPS = 250 / 3.6
 #: Steepest grade accepted [–] (the steepest public streets are about 0.35).
 MAX_ABS_GRADE = 0.5
+_EPOCH_DATE = dt.date(1970, 1, 1)
 
 
 @dataclass(frozen=True)
@@ -52,6 +56,10 @@ class SimulationResult:
         Mean electric power of each consumer over each step [W], ``n − 1`` values each.
     energy_kwh
         Energy of each consumer and ``total`` [kWh].
+    battery_loss_kwh
+        Extra battery energy of the temperature derating (:mod:`core.battery`) [kWh].
+    grid_kwh
+        Energy drawn from the grid before departure to pre-condition cab and box [kWh].
     distance_m, duration_s
         Distance [m] and duration [s] of the trace.
     soc
@@ -62,14 +70,20 @@ class SimulationResult:
         Cargo-box heat flows and temperatures.
     ambient_c
         Ambient temperature of each step [°C].
-    weather, weather_source
-        The day's extremes used and whether they came from the request or the climatology.
+    weather
+        The first day's extremes.
+    weather_days
+        The extremes of every local day of the trace.
+    weather_source
+        Where the weather came from.
     """
 
     time_s: FloatArray
     speed_mps: FloatArray
     power_w: dict[str, FloatArray]
     energy_kwh: dict[str, float]
+    battery_loss_kwh: float
+    grid_kwh: float
     distance_m: float
     duration_s: float
     soc: FloatArray
@@ -77,73 +91,8 @@ class SimulationResult:
     box: BoxResult
     ambient_c: FloatArray
     weather: Weather
+    weather_days: list[DayWeather]
     weather_source: WeatherSource
-
-
-@dataclass(frozen=True)
-class LocalClock:
-    """Local clock time along a trace.
-
-    Attributes
-    ----------
-    hour
-        Clock hour of each moment [h since local midnight].
-    day_index
-        Day of each moment, 0 for the start day.
-    dates
-        The calendar date of each day index.
-    """
-
-    hour: FloatArray
-    day_index: NDArray[np.int_]
-    dates: list[dt.date]
-
-    def per_moment(self, per_day: ArrayLike) -> FloatArray:
-        """Spread one value per day to every moment."""
-        return np.asarray(per_day, dtype=float)[self.day_index]
-
-
-def local_clock(start: dt.datetime, offsets_s: FloatArray) -> LocalClock:
-    """Local clock time at ``start + offsets_s``; the start's UTC offset holds throughout.
-
-    Parameters
-    ----------
-    start
-        Timezone-aware start.
-    offsets_s
-        Seconds after the start [s], >= 0.
-    """
-    start_hour = start.hour + start.minute / 60 + (start.second + start.microsecond / 1e6) / 3600
-    hours = start_hour + offsets_s / 3600.0
-    day_index = np.floor(hours / 24.0).astype(int)
-    n_days = int(day_index.max()) + 1 if day_index.size else 1
-    dates = [start.date() + dt.timedelta(days=d) for d in range(n_days)]
-    return LocalClock(hours - 24.0 * day_index, day_index, dates)
-
-
-def door_open_fraction(
-    openings: Sequence[DoorOpening], step_end_s: FloatArray, dt_s: float
-) -> FloatArray:
-    """Share of each step [–] during which the door is open.
-
-    The door's total open time up to ``t`` is piecewise linear in ``t`` (slope 1 while any
-    opening is under way, so overlapping openings count once); it is built from the sorted start
-    and end events and read at the step edges with one interpolation. Its difference over a
-    step, divided by the step length, is the share.
-    """
-    if not openings:
-        return np.zeros(step_end_s.size)
-    start = np.array([o.start_s for o in openings])
-    end = start + np.array([o.duration_s for o in openings])
-    events = np.concatenate((start, end))
-    order = np.argsort(events, kind="stable")
-    events = events[order]
-    under_way = np.cumsum(np.concatenate((np.ones(start.size), -np.ones(end.size)))[order])
-    slope = (under_way > 0).astype(float)
-    open_until = np.concatenate(([0.0], np.cumsum(np.diff(events) * slope[:-1])))
-    edges = np.concatenate(([step_end_s[0] - dt_s], step_end_s))
-    total = np.interp(edges, events, open_until)
-    return np.clip(np.diff(total) / dt_s, 0.0, 1.0)
 
 
 def _per_step(value: ArrayLike, n_samples: int, name: str, low: float, high: float) -> FloatArray:
@@ -183,6 +132,25 @@ def check_trace(speed_mps: ArrayLike, dt_s: float) -> FloatArray:
     return speed
 
 
+def sun(utc_s: FloatArray, location: Location) -> tuple[FloatArray, FloatArray]:
+    """Sine of the sun's altitude [–] and the month (1–12) at each UTC instant (eqs 13–14).
+
+    Apparent solar time comes straight from UTC: ``t_solar = t_UTC + λ/15° + E/60``, so a
+    daylight-saving change of the local clock cannot shift the sun.
+    """
+    epoch_day = np.floor(utc_s / SECONDS_PER_DAY).astype(int)
+    first = int(epoch_day[0]) if epoch_day.size else 0
+    n_days = int(epoch_day[-1]) - first + 1 if epoch_day.size else 0
+    dates = [_EPOCH_DATE + dt.timedelta(days=first + d) for d in range(n_days)]
+    day = epoch_day - first
+    # Declination, equation of time and month change once a day: compute them per day.
+    day_of_year = [d.timetuple().tm_yday for d in dates]
+    utc_hour = (utc_s - epoch_day * SECONDS_PER_DAY) / 3600.0
+    solar_hour = solar_time_h(utc_hour, equation_of_time_min(day_of_year)[day], location.lon, 0.0)
+    month = np.array([d.month for d in dates], dtype=int)[day]
+    return sin_altitude(location.lat, declination_deg(day_of_year)[day], solar_hour), month
+
+
 def simulate(
     speed_mps: ArrayLike,
     dt_s: float,
@@ -192,8 +160,10 @@ def simulate(
     *,
     grade: ArrayLike = 0.0,
     payload_kg: ArrayLike | None = None,
-    weather: Weather | None = None,
+    weather: Forecast | None = None,
     door_openings: Sequence[DoorOpening] = (),
+    parked: Sequence[Interval] = (),
+    heading_deg: ArrayLike | None = None,
 ) -> SimulationResult:
     """Simulate every consumer of the van along one speed trace (paper Fig. 7, one leg).
 
@@ -205,7 +175,8 @@ def simulate(
         Sampling interval [s].
     start
         Timezone-aware time of the first sample; sets the sun, the ambient temperature and the
-        cabin load through the day.
+        cabin load through the day. Time advances in true seconds (UTC), so a trace across a
+        daylight-saving change keeps its sun and temperature.
     location
         Where the van drives (latitude for the sun and the climatology; longitude for solar
         time).
@@ -216,74 +187,189 @@ def simulate(
     payload_kg
         Payload [kg], a number or one value per sample; ``None`` takes ``van.payload_kg``.
     weather
-        The day's extremes; ``None`` uses the climatology for the date and latitude.
+        An hourly forecast, the day's extremes, or ``None`` for the climatology of each day.
     door_openings
         When the cargo door is open, in seconds after the start.
+    parked
+        When the van stands at a stop (the cab HVAC's duty while parked), seconds after start.
+    heading_deg
+        Direction of travel at each sample [°, 0 north, 90 east] for the wind; NaN or None
+        where unknown.
 
     Returns
     -------
     SimulationResult
     """
     speed = check_trace(speed_mps, dt_s)
-    if start.tzinfo is None or start.utcoffset() is None:
-        raise InvalidParameterError("start must carry a UTC offset or a time zone", "start")
     n = speed.size
     grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
     payload = van.payload_kg if payload_kg is None else payload_kg
     payload_step = _per_step(payload, n, "payload_kg", 0.0, 40_000.0)
     end_s = (n - 1) * dt_s
-    for index, opening in enumerate(door_openings):
-        if opening.start_s > end_s:
-            raise InvalidParameterError(
-                f"door opening starts at {opening.start_s} s, after the trace ends ({end_s} s)",
-                f"door_openings[{index}].start_s",
-            )
+    for name, windows in (("door_openings", door_openings), ("parked", parked)):
+        for index, window in enumerate(windows):
+            if window.start_s > end_s:
+                raise InvalidParameterError(
+                    f"{name}[{index}] starts at {window.start_s} s, after the trace ends "
+                    f"({end_s} s)",
+                    f"{name}[{index}].start_s",
+                )
+    check_representable(start, end_s)
 
     time_s = np.arange(n) * dt_s
-    mid_s = time_s[1:] - 0.5 * dt_s
-    clock = local_clock(start, mid_s)
-    day_weather, source = resolve_weather(weather, start.date(), location.lat)
-    ambient = daily_temperature_c(day_weather, clock.hour)
-    # Declination, equation of time and month change once a day: compute them per day.
-    day_of_year = [d.timetuple().tm_yday for d in clock.dates]
-    utc_offset_h = start.utcoffset().total_seconds() / 3600.0  # type: ignore[union-attr]
-    solar_hour = solar_time_h(
-        clock.hour, clock.per_moment(equation_of_time_min(day_of_year)), location.lon, utc_offset_h
-    )
-    sin_h = sin_altitude(location.lat, clock.per_moment(declination_deg(day_of_year)), solar_hour)
-    month = clock.per_moment([d.month for d in clock.dates])
+    step_end = time_s[1:]
+    outside = _environment(start, location, van, weather, step_end - 0.5 * dt_s)
+    ambient = outside.ambient_c
+    box_params = van.cargo_box
     box = refrigeration(
-        van.cargo_box,
+        box_params,
         ambient,
-        absorbed_solar_heat_w(van.cargo_box, sin_h, month),
-        door_open_fraction(door_openings, time_s[1:], dt_s),
+        outside.solar_heat_w,
+        door_open_fraction(door_openings, step_end, dt_s),
         payload_step,
         dt_s,
+        initial_c=None if van.precondition_at_depot else float(ambient[0]),
     )
-    mass = van.vehicle.mass_kg + payload_step
+    vehicle = van.vehicle
+    cab_gap_j = (
+        vehicle.cab_recovery_energy_j_k
+        * abs(CAB_SETPOINT_C - float(ambient[0]))
+        * float(cabin_hvac_power_w(vehicle, ambient[0]) > 0)
+    )
+    headwind = (
+        0.0
+        if heading_deg is None or outside.calm
+        else headwind_mps(
+            outside.wind_from_east_mps,
+            outside.wind_from_north_mps,
+            _step_heading(heading_deg, n),
+        )
+    )
     power = {
-        "traction": step_traction_power_w(van.vehicle, speed, dt_s, mass, grade_step),
-        "auxiliaries": auxiliaries_power_w(van.vehicle, n - 1),
-        "cabin": cabin_hvac_power_w(van.vehicle, ambient),
+        "traction": step_traction_power_w(
+            vehicle, speed, dt_s, vehicle.mass_kg + payload_step, grade_step, headwind
+        ),
+        "auxiliaries": auxiliaries_power_w(vehicle, n - 1),
+        "cabin": cab_power_w(
+            vehicle,
+            ambient,
+            step_end,
+            dt_s,
+            [(p.start_s, p.duration_s) for p in parked],
+            0.0 if van.precondition_at_depot else cab_gap_j,
+        ),
         "refrigeration": box.power_w,
     }
     energy = {
         name: float(p.sum() * dt_s / battery_model.JOULES_PER_KWH) for name, p in power.items()
     }
     energy["total"] = sum(energy.values())
-    step_energy = sum(power.values(), np.zeros(n - 1)) * dt_s
-    soc = battery_model.state_of_charge(van.battery, step_energy)
+    consumer_j = sum(power.values(), np.zeros(n - 1)) * dt_s
+    battery_params = van.battery
+    drawn_j = battery_model.battery_energy_j(battery_params, consumer_j, ambient)
+    usable_share = battery_model.capacity_factor(battery_params, float(ambient[0]))
+    soc, verdict = battery_model.discharge(battery_params, drawn_j, usable_share)
+    grid_j = (
+        cab_gap_j + precondition_energy_j(box_params, float(ambient[0]))
+        if van.precondition_at_depot
+        else 0.0
+    )
+    first_day = outside.days[0]
     return SimulationResult(
         time_s=time_s,
         speed_mps=speed,
         power_w=power,
         energy_kwh=energy,
+        battery_loss_kwh=float((drawn_j - consumer_j).sum() / battery_model.JOULES_PER_KWH),
+        grid_kwh=grid_j / battery_model.JOULES_PER_KWH,
         distance_m=trace_distance_m(speed, dt_s),
         duration_s=end_s,
         soc=soc,
-        battery=battery_model.verdict(van.battery, soc, step_energy),
+        battery=verdict,
         box=box,
         ambient_c=ambient,
-        weather=day_weather,
-        weather_source=source,
+        weather=Weather(t_min_c=round(first_day.t_min_c, 2), t_max_c=round(first_day.t_max_c, 2)),
+        weather_days=outside.days,
+        weather_source=outside.source,
     )
+
+
+def door_open_fraction(
+    openings: Sequence[DoorOpening], step_end_s: FloatArray, dt_s: float
+) -> FloatArray:
+    """Share of each step [–] during which the door is open (overlaps count once)."""
+    return interval_fraction(
+        [o.start_s for o in openings], [o.duration_s for o in openings], step_end_s, dt_s
+    )
+
+
+#: Spacing of the points at which the slowly changing outside conditions (temperature, sun,
+#: wind) are computed before they are interpolated to every step [s]: the daily sine changes by
+#: under 0.003 K between a minute's linear interpolation and the curve.
+ENVIRONMENT_STEP_S = 60.0
+
+
+@dataclass(frozen=True)
+class _Environment:
+    """Outside conditions of every step."""
+
+    ambient_c: FloatArray
+    solar_heat_w: FloatArray
+    wind_from_east_mps: FloatArray
+    wind_from_north_mps: FloatArray
+    calm: bool
+    days: list[DayWeather]
+    source: WeatherSource
+
+
+def _environment(
+    start: dt.datetime,
+    location: Location,
+    van: VanParams,
+    weather: Forecast | None,
+    mid_s: FloatArray,
+) -> _Environment:
+    """Temperature, absorbed sun and wind at each step's middle ``mid_s`` [s after start],
+    computed every :data:`ENVIRONMENT_STEP_S` and interpolated linearly."""
+    coarse_s = np.append(np.arange(mid_s[0], mid_s[-1], ENVIRONMENT_STEP_S), mid_s[-1])
+    clock = local_clock(start, coarse_s)
+    outside = conditions(weather, clock, location.lat)
+    sin_h, month = sun(clock.utc_s, location)
+
+    def fine(values: FloatArray) -> FloatArray:
+        return np.interp(mid_s, coarse_s, values)
+
+    calm = not (np.any(outside.wind_from_east_mps) or np.any(outside.wind_from_north_mps))
+    still = np.zeros(0)
+    return _Environment(
+        ambient_c=fine(outside.ambient_c),
+        solar_heat_w=fine(_solar_heat_w(van, outside, sin_h, month)),
+        wind_from_east_mps=still if calm else fine(outside.wind_from_east_mps),
+        wind_from_north_mps=still if calm else fine(outside.wind_from_north_mps),
+        calm=calm,
+        days=outside.days,
+        source=outside.source,
+    )
+
+
+def _solar_heat_w(
+    van: VanParams, outside: Conditions, sin_h: FloatArray, month: FloatArray
+) -> FloatArray:
+    """Absorbed sun on the box [W]: the forecast's sun if there is one, else the clear sky."""
+    if outside.direct_horizontal_w_m2 is None or outside.diffuse_horizontal_w_m2 is None:
+        return absorbed_solar_heat_w(van.cargo_box, sin_h, direct_irradiance_w_m2(sin_h, month))
+    direct = direct_normal_from_horizontal_w_m2(outside.direct_horizontal_w_m2, sin_h)
+    return absorbed_solar_heat_w(van.cargo_box, sin_h, direct, outside.diffuse_horizontal_w_m2)
+
+
+def _step_heading(heading_deg: ArrayLike, n_samples: int) -> FloatArray:
+    """Heading of each step [°]: the value at the step's end sample (headings wrap at 360°, so
+    they are not averaged)."""
+    heading = np.asarray(heading_deg, dtype=float)
+    if heading.ndim == 0:
+        return np.full(n_samples - 1, float(heading))
+    if heading.shape != (n_samples,):
+        raise InvalidParameterError(
+            f"heading_deg must hold one value per speed sample ({n_samples})", "heading_deg"
+        )
+    return heading[1:]

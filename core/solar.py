@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -103,20 +105,52 @@ def direct_irradiance_w_m2(sin_h: ArrayLike, month: ArrayLike) -> FloatArray:
     return np.where(up, ASHRAE_A_W_M2[index] * np.exp(-ASHRAE_B[index] / safe), 0.0)
 
 
-def absorbed_solar_heat_w(box: CargoBoxParams, sin_h: ArrayLike, month: ArrayLike) -> FloatArray:
+def direct_normal_from_horizontal_w_m2(
+    direct_horizontal_w_m2: ArrayLike, sin_h: ArrayLike
+) -> FloatArray:
+    """Direct normal irradiance from direct irradiance on a horizontal surface [W/m²].
+
+    ``S = S_h / sin h``; zero with the sun below 3° (where the division amplifies forecast noise
+    and the low sun's share is negligible).
+    """
+    s = np.asarray(sin_h, dtype=float)
+    high_enough = s > math.sin(math.radians(3.0))
+    safe = np.where(high_enough, s, 1.0)
+    return np.where(high_enough, np.asarray(direct_horizontal_w_m2, dtype=float) / safe, 0.0)
+
+
+def absorbed_solar_heat_w(
+    box: CargoBoxParams,
+    sin_h: ArrayLike,
+    direct_normal_w_m2: ArrayLike,
+    diffuse_horizontal_w_m2: ArrayLike = 0.0,
+) -> FloatArray:
     """Solar heat entering the cargo box [W] (eqs 15–17).
 
-    Roof ``κ*·A_r·S·sin h`` plus sides and back ``κ*·(2A_s + A_b)·S·cos h/π``, times the shadow
-    factor ``b_sh``; zero at night. The effective absorption coefficient is
-    ``κ* = a_s·α/h_o``: the surface absorbs ``a_s`` of the sun, and of that the share
-    ``α/h_o`` crosses the insulated wall instead of going back to the outside air (sol-air
+    Roof ``κ*·A_r·(S·sin h + D)`` plus sides and back ``κ*·(2A_s + A_b)·(S·cos h/π + D/2)``,
+    times the shadow factor ``b_sh``; zero at night. ``S`` is the direct normal irradiance and
+    ``D`` the diffuse irradiance on a horizontal surface, which the paper leaves out (clear sky)
+    and a forecast provides; a vertical wall sees half the sky. The effective absorption
+    coefficient is ``κ* = a_s·α/h_o``: the surface absorbs ``a_s`` of the sun, and of that the
+    share ``α/h_o`` crosses the insulated wall instead of going back to the outside air (sol-air
     temperature method, ASHRAE Handbook – Fundamentals, ch. 18).
+
+    Parameters
+    ----------
+    sin_h
+        Sine of the sun's altitude [–].
+    direct_normal_w_m2
+        S [W/m²] (:func:`direct_irradiance_w_m2` for the clear sky).
+    diffuse_horizontal_w_m2
+        D [W/m²].
     """
     s = np.clip(np.asarray(sin_h, dtype=float), 0.0, 1.0)
-    irradiance = direct_irradiance_w_m2(s, month)
-    crossing = min(1.0, box.wall_heat_transfer_w_m2k / box.outside_film_coefficient_w_m2k)
-    kappa = box.solar_absorptivity * crossing
+    direct = np.where(s > 0, np.asarray(direct_normal_w_m2, dtype=float), 0.0)
+    diffuse = np.asarray(diffuse_horizontal_w_m2, dtype=float)
+    kappa = box.solar_absorptivity * min(
+        1.0, box.wall_heat_transfer_w_m2k / box.outside_film_coefficient_w_m2k
+    )
     cos_h = np.sqrt(1.0 - s**2)
-    roof = box.roof_area_m2 * s
-    sides = (2.0 * box.side_area_m2 + box.back_area_m2) * cos_h / np.pi
-    return kappa * irradiance * (roof + sides) * box.shadow_factor
+    roof = box.roof_area_m2 * (direct * s + diffuse)
+    sides = (2.0 * box.side_area_m2 + box.back_area_m2) * (direct * cos_h / np.pi + diffuse / 2)
+    return kappa * (roof + sides) * box.shadow_factor

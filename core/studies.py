@@ -18,6 +18,7 @@ from core.params import (
     CALM_DRIVER,
     NORMAL_DRIVER,
     STREET_TYPES,
+    Depot,
     Location,
     Params,
     RoadMatrix,
@@ -26,6 +27,7 @@ from core.params import (
     Weather,
 )
 from core.plan import PlanProblem, PlanResult, plan
+from core.roads import LegRoute, RoadRouter, RoadTable, WeatherService
 from core.simulate import CONSUMERS, simulate
 
 #: Shortest swept trip [m]: shorter ones are all ramp and say nothing about a cruising speed.
@@ -152,12 +154,37 @@ DEFAULT_DRIVERS = (CALM_DRIVER, NORMAL_DRIVER, AGGRESSIVE_DRIVER)
 DEFAULT_TRAFFIC = (0.2, 0.8)
 
 
+class _RememberingRouter:
+    """A road router that asks its inner router once per set of places and once per leg: the
+    cells of a grid drive the same roads."""
+
+    def __init__(self, inner: RoadRouter) -> None:
+        self.inner = inner
+        self.name = inner.name
+        self._tables: dict[tuple[tuple[float, float], ...], RoadTable] = {}
+        self._routes: dict[tuple[float, float, float, float], LegRoute] = {}
+
+    def table(self, places: Sequence[Depot]) -> RoadTable:
+        key = tuple((p.lat, p.lon) for p in places)
+        if key not in self._tables:
+            self._tables[key] = self.inner.table(places)
+        return self._tables[key]
+
+    def route(self, origin: Depot, destination: Depot) -> LegRoute:
+        key = (origin.lat, origin.lon, destination.lat, destination.lon)
+        if key not in self._routes:
+            self._routes[key] = self.inner.route(origin, destination)
+        return self._routes[key]
+
+
 def scenario_grid(
     problem: PlanProblem,
     seasons: Sequence[Season] | None = None,
     drivers: Sequence[float] | None = None,
     traffic: Sequence[float | None] | None = None,
     progress: Callable[[int, int], None] | None = None,
+    router: RoadRouter | None = None,
+    weather_service: WeatherService | None = None,
 ) -> ScenarioGrid:
     """The round of ``problem`` over every combination of season, driver and traffic.
 
@@ -175,6 +202,9 @@ def scenario_grid(
         light/heavy traffic (ε_t 0.2, 0.8).
     progress
         Called with (cells done, cells in all) after each cell.
+    router, weather_service
+        As for :func:`core.plan.plan`; the router is asked once per leg for the whole grid.
+        A season with its own weather keeps it; the others get the service's forecast.
     """
     seasons = list(seasons) if seasons is not None else default_seasons(problem.date.year)
     drivers = list(drivers) if drivers is not None else list(DEFAULT_DRIVERS)
@@ -186,7 +216,8 @@ def scenario_grid(
     ):
         if not axis:
             raise InvalidParameterError(f"{name} must hold at least one value", name)
-    baseline = plan(problem)
+    remembering = None if router is None else _RememberingRouter(router)
+    baseline = plan(problem, remembering, weather_service)
     by_id = {stop.id: stop for stop in problem.stops}
     fixed = problem.model_copy(
         update={
@@ -206,7 +237,9 @@ def scenario_grid(
                     "driver_aggressiveness": driver,
                     "traffic_density": density,
                 }
-            )
+            ),
+            remembering,
+            weather_service,
         )
         cells.append(_cell(season.name, driver, density, result, baseline))
         if progress is not None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core.arrays import FloatArray
+from core.arrays import FloatArray, reflected_cumsum
 from core.params import GRAVITY_MPS2, VehicleParams
 
 
@@ -33,17 +33,29 @@ def rolling_force_n(vehicle: VehicleParams, mass_kg: ArrayLike) -> FloatArray:
     )
 
 
-def drag_force_n(vehicle: VehicleParams, speed_mps: ArrayLike) -> FloatArray:
-    """Aerodynamic drag ``F_drag = ½·ρ·A_f·c_d·v²`` [N] (eq. 3).
+def drag_force_n(
+    vehicle: VehicleParams, speed_mps: ArrayLike, headwind_mps: ArrayLike = 0.0
+) -> FloatArray:
+    """Aerodynamic drag ``F_drag = ½·ρ·A_f·c_d·v_air·|v_air|`` [N] (eq. 3).
+
+    ``v_air = v + w`` is the speed through the air with a headwind ``w``; the paper's still air
+    is ``w = 0``. A tailwind faster than the van pushes it (negative drag).
 
     Parameters
     ----------
     speed_mps
-        Speed over ground [m/s] (still air).
+        Speed over ground [m/s].
+    headwind_mps
+        Wind component against the direction of travel [m/s]; negative for a tailwind.
     """
-    v = np.asarray(speed_mps, dtype=float)
+    airspeed = np.asarray(speed_mps, dtype=float) + np.asarray(headwind_mps, dtype=float)
     return (
-        0.5 * vehicle.air_density_kg_m3 * vehicle.frontal_area_m2 * vehicle.drag_coefficient * v**2
+        0.5
+        * vehicle.air_density_kg_m3
+        * vehicle.frontal_area_m2
+        * vehicle.drag_coefficient
+        * airspeed
+        * np.abs(airspeed)
     )
 
 
@@ -68,15 +80,18 @@ def traction_force_n(
     speed_mps: ArrayLike,
     accel_mps2: ArrayLike,
     grade: ArrayLike,
+    headwind_mps: ArrayLike = 0.0,
 ) -> FloatArray:
     """Tractive force ``F_acc = F_fric + F_drag + F_sl + m·dv/dt`` [N] (eq. 2).
 
-    Rolling resistance acts only while the van moves (zero at standstill).
+    Rolling resistance and drag act only while the van moves (zero at standstill).
     """
     v = np.asarray(speed_mps, dtype=float)
     m = np.asarray(mass_kg, dtype=float)
-    rolling = np.where(v > 0, rolling_force_n(vehicle, m), 0.0)
-    return rolling + drag_force_n(vehicle, v) + slope_force_n(m, grade) + m * np.asarray(accel_mps2)
+    moving = v > 0
+    rolling = np.where(moving, rolling_force_n(vehicle, m), 0.0)
+    drag = np.where(moving, drag_force_n(vehicle, v, headwind_mps), 0.0)
+    return rolling + drag + slope_force_n(m, grade) + m * np.asarray(accel_mps2)
 
 
 def electric_power_w(vehicle: VehicleParams, mechanical_power_w: ArrayLike) -> FloatArray:
@@ -93,12 +108,33 @@ def electric_power_w(vehicle: VehicleParams, mechanical_power_w: ArrayLike) -> F
     return np.where(p >= 0, p / vehicle.drivetrain_efficiency, regen)
 
 
+def motor_limited_power_w(
+    vehicle: VehicleParams, mechanical_power_w: FloatArray, dt_s: float
+) -> FloatArray:
+    """Mechanical power the motor delivers for a demanded power, capped at
+    ``max_motor_power_w`` [W].
+
+    What the cap withholds is not lost: the van falls behind the trace and the motor keeps
+    delivering its full power until it has caught up, ``b_k = max(0, b_{k−1} +
+    (P_k − P_max)·Δt)``, ``P_delivered,k = P_k − (b_k − b_{k−1})/Δt`` (vectorised with
+    :func:`core.arrays.reflected_cumsum`). The kinetic and potential energy of the trace are
+    delivered in full, a little later.
+    """
+    cap = vehicle.max_motor_power_w
+    if cap is None or mechanical_power_w.size == 0:
+        return mechanical_power_w
+    behind_j = reflected_cumsum((mechanical_power_w - cap) * dt_s)
+    caught_up_j = np.diff(behind_j, axis=-1, prepend=0.0)
+    return mechanical_power_w - caught_up_j / dt_s
+
+
 def step_traction_power_w(
     vehicle: VehicleParams,
     speed_mps: FloatArray,
     dt_s: float,
     mass_kg: ArrayLike,
     grade: ArrayLike,
+    headwind_mps: ArrayLike = 0.0,
 ) -> FloatArray:
     """Electric traction power of every step of a speed trace [W] (eqs 2, 6, 7).
 
@@ -108,16 +144,17 @@ def step_traction_power_w(
         Speed samples, ``n`` values [m/s].
     dt_s
         Sampling interval [s].
-    mass_kg, grade
-        Total mass [kg] and grade [–] of each step: scalars or ``n - 1`` values.
+    mass_kg, grade, headwind_mps
+        Total mass [kg], grade [–] and headwind [m/s] of each step: scalars or ``n − 1``
+        values (grade may also carry leading axes, e.g. a table of grades).
 
     Returns
     -------
     numpy.ndarray
-        ``n - 1`` values: the mean battery power over each step [W].
+        ``n − 1`` values: the mean battery power over each step [W].
     """
     v_start, v_end = speed_mps[:-1], speed_mps[1:]
     v_mean = 0.5 * (v_start + v_end)
     accel = (v_end - v_start) / dt_s
-    mechanical = traction_force_n(vehicle, mass_kg, v_mean, accel, grade) * v_mean
-    return electric_power_w(vehicle, mechanical)
+    mechanical = traction_force_n(vehicle, mass_kg, v_mean, accel, grade, headwind_mps) * v_mean
+    return electric_power_w(vehicle, motor_limited_power_w(vehicle, mechanical, dt_s))

@@ -2,7 +2,13 @@ import numpy as np
 import pytest
 
 from core.arrays import reflected_cumsum
-from core.battery import JOULES_PER_KWH, state_of_charge, verdict
+from core.battery import (
+    JOULES_PER_KWH,
+    battery_energy_j,
+    capacity_factor,
+    discharge,
+    energy_factor,
+)
 from core.params import BatteryParams
 
 KWH = JOULES_PER_KWH
@@ -20,7 +26,7 @@ def test_reflected_cumsum_matches_loop():
 
 def test_soc_falls_with_energy_and_stops_at_full():
     battery = BatteryParams(usable_capacity_kwh=10, initial_soc=1.0, min_soc=0.1)
-    soc = state_of_charge(battery, np.array([-1, 2, 3, -1]) * KWH)
+    soc, _ = discharge(battery, np.array([-1, 2, 3, -1]) * KWH)
     # regen at full is lost; then 1.0 → 0.8 → 0.5 → 0.6
     assert soc == pytest.approx([1.0, 1.0, 0.8, 0.5, 0.6])
 
@@ -28,7 +34,7 @@ def test_soc_falls_with_energy_and_stops_at_full():
 def test_verdict_feasible_with_margin_and_required_capacity():
     battery = BatteryParams(usable_capacity_kwh=10, initial_soc=0.9, min_soc=0.1)
     energy = np.array([2.0, 3.0, -1.0]) * KWH
-    result = verdict(battery, state_of_charge(battery, energy), energy)
+    _, result = discharge(battery, energy)
     assert result.feasible and result.first_infeasible_index is None
     assert result.min_soc == pytest.approx(0.4) and result.final_soc == pytest.approx(0.5)
     assert result.margin_kwh == pytest.approx(3.0)  # (0.4 − 0.1) · 10 kWh
@@ -38,8 +44,39 @@ def test_verdict_feasible_with_margin_and_required_capacity():
 def test_verdict_infeasible_names_first_sample_below_reserve():
     battery = BatteryParams(usable_capacity_kwh=10, initial_soc=1.0, min_soc=0.2)
     energy = np.array([4.0, 3.0, 2.0, 1.0]) * KWH  # soc 1, .6, .3, .1, 0
-    result = verdict(battery, state_of_charge(battery, energy), energy)
+    _, result = discharge(battery, energy)
     assert not result.feasible
     assert result.first_infeasible_index == 3
     assert result.margin_kwh == pytest.approx(-2.0)
     assert result.required_capacity_kwh == pytest.approx(10.0 / 0.8)
+
+
+def test_temperature_derating_follows_aaa_2019():
+    # AAA "Electric Vehicle Range Testing" (2019), HVAC off, against 23.9 °C: at −6.7 °C the
+    # economy fell 9 % (energy × 1/0.91) and the range 12 % (usable energy 0.88/0.91).
+    battery = BatteryParams(temperature_derating=True)
+    assert energy_factor(battery, -6.7) == pytest.approx(1 / 0.91)
+    assert capacity_factor(battery, -6.7) == pytest.approx(0.88 / 0.91)
+    assert energy_factor(battery, 23.9) == 1.0 and capacity_factor(battery, 23.9) == 1.0
+    # 95 °F (35 °C): economy −5 %; the range fell less (−4 %), so no capacity is taken away
+    assert energy_factor(battery, 35.0) == pytest.approx(1 / 0.95)
+    assert capacity_factor(battery, 35.0) == 1.0
+    # the paper's battery knows no temperature
+    assert energy_factor(BatteryParams(), -20.0) == 1.0
+    assert capacity_factor(BatteryParams(), -20.0) == 1.0
+
+
+def test_derated_discharge_in_the_cold():
+    battery = BatteryParams(usable_capacity_kwh=10, temperature_derating=True)
+    drawn = battery_energy_j(battery, np.array([1.0, -1.0]) * KWH, -6.7)
+    # discharging costs 1/0.91 kWh per kWh; regenerating stores only 0.91
+    assert drawn == pytest.approx(np.array([1 / 0.91, -0.91]) * KWH)
+    soc, result = discharge(battery, np.array([1 / 0.91]) * KWH, capacity_factor(battery, -6.7))
+    assert soc[-1] == pytest.approx(1 - (1 / 0.91) / (10 * 0.88 / 0.91))
+    assert result.usable_capacity_kwh == pytest.approx(10 * 0.88 / 0.91)
+
+
+def test_recharge_at_the_plug():
+    battery = BatteryParams(usable_capacity_kwh=10, charging_efficiency=0.9)
+    _, result = discharge(battery, np.array([2.0, 1.0]) * KWH)
+    assert result.recharge_kwh == pytest.approx(3.0 / 0.9)

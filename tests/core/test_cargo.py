@@ -1,11 +1,19 @@
+import datetime as dt
+from zoneinfo import ZoneInfo
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from core.cargo import (
+    MAX_CARNOT_COP,
     air_density_kg_m3,
     door_heat_w,
     heat_capacity_j_k,
+    precondition_energy_j,
     refrigeration,
+    refrigeration_cop,
     wall_heat_w,
 )
 from core.params import CargoBoxParams
@@ -74,23 +82,42 @@ def test_dynamic_mode_with_ample_capacity_equals_steady():
     assert dynamic.max_temperature_c == 4.0
 
 
+def _exact_c(ambient_c, start_c, conductance_w_k, capacity_j_k, unit_w, seconds):
+    """C·dϑ/dt = G·(ϑ_amb − ϑ) − Q: ϑ(t) = ϑ_eq + (ϑ_0 − ϑ_eq)·exp(−G·t/C), ϑ_eq = ϑ_amb − Q/G."""
+    equilibrium = ambient_c - unit_w / conductance_w_k
+    return equilibrium + (start_c - equilibrium) * np.exp(-conductance_w_k * seconds / capacity_j_k)
+
+
+UA = 2.172 * AREA  # 66.47 W/K (eq. 11)
+
+
 def test_dynamic_mode_warms_when_capacity_is_short():
-    # load 1994.16 W vs capacity 1000 W for 600 s: E = 994.16 · 600 = 596.5 kJ above set-point;
-    # heat capacity 550 kg · 2300 + 8 m³ air (1.2736 kg/m³ · 1006) = 1,265,250 J/K → +0.4714 K
+    # 34 °C outside, 1000 W of cooling against a 1994 W wall load: the box warms along the
+    # exact first-order response with the loads at its current temperature. Heat capacity:
+    # 550 kg · 2300 + 8 m³ of air + 190 kJ/K of box structure.
     box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000)
     result = _run(box, 34.0)
     capacity = heat_capacity_j_k(box, 550.0)
-    assert capacity == pytest.approx(550 * 2300 + 8 * air_density_kg_m3(4.0) * 1006)
-    assert result.max_temperature_c == pytest.approx(4 + 994.16 * 600 / capacity, abs=1e-3)
+    assert capacity == pytest.approx(550 * 2300 + 8 * air_density_kg_m3(4.0) * 1006 + 190_000)
+    expected = _exact_c(34.0, 4.0, UA, capacity, 1000.0, 600.0)  # 4.40 °C
+    assert result.max_temperature_c == pytest.approx(expected, abs=2e-3)
     assert result.power_w == pytest.approx(np.full(600, 1000 / 1.5))
+    # the wall gain shrinks as the box warms
+    assert result.wall_heat_w[-1] == pytest.approx(UA * (34 - result.temperature_c[-1]))
 
 
 def test_dynamic_mode_counts_minutes_above_product_limit():
-    # empty box (air only, 10.25 kJ/K): 994 W excess lifts it 3 K (to the 7 °C limit) in 31 s
+    # empty box (air + structure ≈ 200 kJ/K): 7 °C is crossed at
+    # t = −τ·ln((7 − ϑ_eq)/(4 − ϑ_eq)), τ = C/UA, ϑ_eq = 34 − 1000/UA
     box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000)
-    result = _run(box, 34.0, payload=0.0)
-    crossing_s = 3.0 * heat_capacity_j_k(box, 0.0) / 994.16
-    assert result.minutes_above_limit == pytest.approx((600 - np.ceil(crossing_s)) / 60, abs=0.02)
+    result = _run(box, 34.0, payload=0.0, n=1200)
+    capacity = heat_capacity_j_k(box, 0.0)
+    equilibrium = 34 - 1000 / UA
+    crossing_s = -capacity / UA * np.log((7 - equilibrium) / (4 - equilibrium))
+    assert result.minutes_above_limit == pytest.approx((1200 - crossing_s) / 60, abs=0.2)
+    assert result.max_temperature_c == pytest.approx(
+        _exact_c(34.0, 4.0, UA, capacity, 1000.0, 1200.0), abs=2e-3
+    )
 
 
 def test_dynamic_box_recovers_after_the_load_drops():
@@ -99,4 +126,113 @@ def test_dynamic_box_recovers_after_the_load_drops():
     n = ambient.size
     result = refrigeration(box, ambient, np.zeros(n), np.zeros(n), np.full(n, 550.0), 1.0)
     assert result.temperature_c[-1] == pytest.approx(4.0)
-    assert result.max_temperature_c > 4.1
+    assert result.max_temperature_c > 4.05
+
+
+def test_empty_box_with_an_open_door_stays_below_the_outside_air():
+    # Issue #10 repro: an empty dynamic box, 30 °C all day, door open 300 s from t = 100 s.
+    # The old model reached 78 °C; walls and door at the box's temperature bound it by the
+    # outside air and its sol-air excess. By hand (no sun at 03:00): G = UA + G_door,
+    # ϑ_eq = 30 − 3000 W / G, exact response over the 300 s of open door.
+    from core.params import DoorOpening, Location, VanParams, Weather
+    from core.simulate import simulate
+
+    box = CargoBoxParams(mode="dynamic")
+    van = VanParams(cargo_box=box)
+    start = dt.datetime(2026, 7, 15, 3, tzinfo=ZoneInfo("Europe/Vienna"))
+    result = simulate(
+        np.zeros(1201),
+        1,
+        start,
+        Location(lat=48.21, lon=16.37),
+        van,
+        payload_kg=0.0,
+        weather=Weather(t_min_c=30, t_max_c=30),
+        door_openings=[DoorOpening(start_s=100, duration_s=300)],
+    )
+    door_g = door_heat_w(box, 30.0, 4.0) / 26.0
+    expected = _exact_c(30.0, 4.0, UA + door_g, heat_capacity_j_k(box, 0.0), 3000.0, 300.0)
+    assert result.box.max_temperature_c == pytest.approx(expected, abs=0.05)
+    assert result.box.max_temperature_c < 30.0
+    assert result.box.temperature_c[-1] == pytest.approx(4.0)
+
+
+def test_unloading_changes_the_heat_capacity_not_the_temperature():
+    # 550 kg unloaded in one step while the box is warm: no jump (the old model jumped
+    # 4.6 → 38.9 °C, dividing the stored heat by a smaller capacity).
+    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=500)
+    n = 1800
+    payload = np.where(np.arange(n) < 900, 550.0, 0.0)
+    result = refrigeration(box, np.full(n, 34.0), np.zeros(n), np.zeros(n), payload, 1.0)
+    steps = np.abs(np.diff(result.temperature_c))
+    assert steps.max() < 0.05
+    # the lighter box then warms faster
+    assert np.diff(result.temperature_c)[1000] > np.diff(result.temperature_c)[800]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    ambient=st.lists(st.floats(-30, 50), min_size=2, max_size=6),
+    solar_w=st.floats(0, 3000),
+    door=st.floats(0, 1),
+    payload_kg=st.floats(0, 2000),
+    cooling_w=st.floats(100, 8000),
+    heater=st.booleans(),
+    start_c=st.one_of(st.none(), st.floats(-30, 50)),
+)
+def test_box_stays_within_what_outside_air_sun_and_setpoint_allow(
+    ambient, solar_w, door, payload_kg, cooling_w, heater, start_c
+):
+    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=cooling_w, heater_enabled=heater)
+    n = 600 * len(ambient)
+    ambient_c = np.repeat(ambient, 600)
+    solar = np.full(n, solar_w)
+    result = refrigeration(
+        box, ambient_c, solar, np.full(n, door), np.full(n, payload_kg), 1.0, start_c
+    )
+    # sol-air: the warmest the walls can drive the box is ϑ_amb + Q_sol/UA
+    warmest = max(box.setpoint_c, float((ambient_c + solar / UA).max()), start_c or -99)
+    coldest = min(box.setpoint_c, float(ambient_c.min()), start_c if start_c is not None else 99)
+    assert result.temperature_c.max() <= warmest + 1e-6
+    assert result.temperature_c.min() >= coldest - 1e-6
+    assert np.all(result.power_w >= 0)
+
+
+def test_carnot_cop_by_hand():
+    # evaporator 4 − 10 = −6 °C (267.15 K), condenser 30 + 15 = 45 °C (318.15 K):
+    # 0.3 · 267.15 / 51 = 1.5715 — the paper's η_RU 1.5 at its design point
+    box = CargoBoxParams(cop_model="carnot")
+    assert refrigeration_cop(box, 30.0, 4.0) == pytest.approx(1.5715, abs=1e-4)
+    # frozen goods: 0.3 · 243.15 / 75 = 0.9726
+    assert refrigeration_cop(box, 30.0, -20.0) == pytest.approx(0.9726, abs=1e-4)
+    # a cool day cannot make the compressor arbitrarily efficient
+    assert refrigeration_cop(box, -10.0, 4.0) == MAX_CARNOT_COP
+    assert refrigeration_cop(CargoBoxParams(), 40.0, 4.0) == 1.5  # the paper's constant
+
+
+def test_cold_day_heats_over_heating_cop_with_standby():
+    box = CargoBoxParams(heater_enabled=True, heating_cop=2.0, standby_power_w=150)
+    result = _run(box, -6.0)
+    # wall loss 664.72 W / COP_heat 2 + 150 W standby
+    assert result.power_w == pytest.approx(np.full(600, 664.72 / 2 + 150), abs=0.05)
+
+
+def test_dynamic_heater_short_of_the_loss_lets_the_box_cool():
+    box = CargoBoxParams(mode="dynamic", heater_enabled=True, heating_capacity_w=300)
+    result = _run(box, -10.0, n=1800)
+    expected = _exact_c(-10.0, 4.0, UA, heat_capacity_j_k(box, 550.0), -300.0, 1800.0)
+    assert result.temperature_c[-1] == pytest.approx(expected, abs=2e-3)
+    assert result.power_w == pytest.approx(np.full(1800, 300.0))
+
+
+def test_warm_box_structure_is_pulled_down_at_the_units_capacity():
+    # steady mode, not pre-cooled: 190 kJ/K · (30 − 4) K = 4.94 MJ extra at 3 kW → 1647 s
+    box = CargoBoxParams()
+    cold = _run(box, 30.0, n=3600)
+    warm = refrigeration(
+        box, np.full(3600, 30.0), np.zeros(3600), np.zeros(3600), np.full(3600, 550.0), 1.0, 30.0
+    )
+    extra_j = (warm.power_w - cold.power_w).sum() * box.cop
+    assert extra_j == pytest.approx(190_000 * 26, rel=1e-9)
+    assert (warm.power_w - cold.power_w)[0] == pytest.approx(3000 / 1.5)
+    assert precondition_energy_j(box, 30.0) == pytest.approx(190_000 * 26 / 1.5)

@@ -4,6 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from core.cycles import (
+    drive_profile,
     generate_leg,
     load_cycle_csv,
     nedc,
@@ -11,7 +12,7 @@ from core.cycles import (
     trace_distance_m,
 )
 from core.exceptions import InvalidParameterError
-from core.params import STREET_TYPES
+from core.params import STREET_TYPES, StreetType
 
 URBAN = STREET_TYPES["urban"]
 
@@ -136,3 +137,54 @@ def test_bad_csv_is_rejected(tmp_path, content, message):
     path.write_text(content)
     with pytest.raises(InvalidParameterError, match=message):
         load_cycle_csv(path)
+
+
+STEADY = StreetType(mean_speed_mps=10, speed_variation=0, period_divisor=1, traffic_density=0.5)
+
+
+def test_road_profile_by_hand():
+    # One 1000 m segment at 10 m/s, no waves, calm driver: 0.2 · 2 = 0.4 m/s² up and down.
+    # Ramp 25 s and 125 m each way, cruise 750 m in 75 s: 125 s in all.
+    trace, travelled = drive_profile(np.array([1000.0]), np.array([10.0]), STEADY, 0.2, 2.0)
+    assert trace[0] == trace[-1] == 0
+    assert trace.size - 1 == pytest.approx(125, abs=1)
+    assert trace.max() == pytest.approx(10.0, rel=1e-3)
+    assert trace_distance_m(trace, 1.0) == pytest.approx(1000.0, rel=1e-9)
+    assert travelled[-1] == pytest.approx(1000.0) and np.all(np.diff(travelled) >= 0)
+    assert np.abs(np.diff(trace)).max() <= 0.4 * 1.01
+
+
+def test_road_profile_brakes_ahead_of_a_slow_segment():
+    # 400 m at 15 m/s, 50 m at 5 m/s (a tight bend), 400 m at 15 m/s
+    lengths = np.array([400.0, 50.0, 400.0])
+    trace, travelled = drive_profile(lengths, np.array([15.0, 5.0, 15.0]), STEADY, 0.5, 2.0)
+    in_bend = (travelled >= 400) & (travelled <= 450)
+    assert trace[in_bend].max() <= 5.0 * 1.01
+    assert trace.max() == pytest.approx(15.0, rel=0.02)
+    assert trace_distance_m(trace, 1.0) == pytest.approx(850.0, rel=1e-9)
+
+
+def test_road_profile_never_exceeds_the_road_and_traffic_slows_it():
+    rng = np.random.default_rng(5)
+    lengths = rng.uniform(20, 400, 40)
+    speeds = rng.uniform(6, 20, 40)
+    light, heavy = (
+        drive_profile(lengths, speeds, STREET_TYPES["urban"], 0.5, 2.0, density)[0]
+        for density in (0.1, 0.9)
+    )
+    ceiling = speeds.max()
+    assert light.max() <= ceiling * 1.01 and heavy.max() <= ceiling * 1.01
+    # more traffic: more slow-downs, a longer leg over the same road
+    assert heavy.size > light.size
+    free_flow_s = float(np.sum(lengths / speeds))
+    assert light.size > free_flow_s  # ramps and slow-downs on top of the free flow
+
+
+def test_road_profile_rejects_bad_segments():
+    with pytest.raises(InvalidParameterError):
+        drive_profile(np.array([100.0, -1]), np.array([10.0, 10]), STEADY, 0.5, 2.0)
+    with pytest.raises(InvalidParameterError):
+        drive_profile(np.array([100.0]), np.array([10.0, 10]), STEADY, 0.5, 2.0)
+    # a router's zero or absurd speed is clamped, not trusted
+    trace, _ = drive_profile(np.array([100.0, 100]), np.array([0.0, 1e6]), STEADY, 0.5, 2.0)
+    assert trace.max() <= 60.0 and trace_distance_m(trace, 1.0) == pytest.approx(200.0)

@@ -10,6 +10,7 @@ from core.geo import (
     build_legs,
     great_circle_m,
     street_type_by_length,
+    street_type_by_speed,
 )
 from core.params import STREET_TYPES, Depot, RoadMatrix
 
@@ -50,7 +51,7 @@ def test_default_legs_distance_duration_grade():
     )
     assert legs.grade[0, 1] == pytest.approx(30 / legs.distance_m[0, 1])
     assert legs.grade[1, 0] == pytest.approx(-legs.grade[0, 1])
-    assert legs.street_type_name(0, 1) == "urban" and not legs.from_client
+    assert legs.street_type_name(0, 1) == "urban" and legs.source == "estimate"
 
 
 def test_missing_elevation_means_flat():
@@ -67,7 +68,22 @@ def test_client_matrix_is_used_as_is():
         TWO, RoadMatrix(**MATRIX, street_types=[["urban", "highway"], ["highway", "urban"]])
     )
     assert legs.distance_m[1, 0] == 1200 and legs.duration_s[0, 1] == 120
-    assert legs.street_type_name(0, 1) == "highway" and legs.from_client
+    assert legs.street_type_name(0, 1) == "highway" and legs.source == "client"
+
+
+def test_client_matrix_without_street_types_types_legs_by_speed():
+    # 1000 m in 120 s = 30 km/h: urban; 20 km in 15 min = 80 km/h: expressway (≥ 80 km/h)
+    matrix = RoadMatrix(distances_m=[[0, 1000], [20_000, 0]], durations_s=[[0, 120], [900, 0]])
+    legs = build_legs(TWO, matrix)
+    assert legs.street_type_name(0, 1) == "urban"
+    assert legs.street_type_name(1, 0) == "expressway"
+
+
+def test_street_type_by_speed_bounds():
+    # 45 and 80 km/h, between the street types' 30, 70 and 100 km/h
+    distance = np.array([44.9, 45.0, 79.9, 80.0, 10.0]) / 3.6 * 3600
+    duration = np.array([3600.0, 3600, 3600, 3600, 0])
+    assert list(street_type_by_speed(distance, duration)) == [0, 1, 1, 2, 0]
 
 
 @pytest.mark.parametrize(

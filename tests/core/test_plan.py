@@ -7,8 +7,18 @@ import pytest
 
 from core.exceptions import CoreError, InvalidStopsError
 from core.geo import build_legs
-from core.params import BatteryParams, CargoBoxParams, Depot, RoadMatrix, Stop, VanParams
+from core.params import (
+    BatteryParams,
+    CargoBoxParams,
+    Depot,
+    RoadMatrix,
+    Stop,
+    VanParams,
+    VehicleParams,
+    Weather,
+)
 from core.plan import PlanProblem, plan
+from core.weather import climatology
 
 DEPOT = Depot(id="depot", lat=48.2082, lon=16.3738)
 
@@ -176,6 +186,8 @@ def test_dynamic_box_reports_temperatures():
             "stops",
         ),
         ({"timezone": "Mars/Olympus"}, CoreError, "timezone"),
+        ({"date": dt.date(2026, 3, 29), "start_time": dt.time(2, 30)}, CoreError, "start_time"),
+        ({"date": dt.date(9999, 12, 31), "start_time": dt.time(23, 59)}, CoreError, "date"),
     ],
 )
 def test_bad_rounds_name_the_problem(change, error, field):
@@ -203,3 +215,65 @@ def test_bad_problem_fields(fields, name):
 def test_door_longer_than_service_is_rejected():
     with pytest.raises(CoreError, match="door_open_s must not exceed service_time_s"):
         Stop(id="A", lat=48.2, lon=16.3, service_time_s=60, door_open_s=120)
+
+
+@pytest.mark.parametrize(
+    ("date", "offset_at_return"),
+    [(dt.date(2026, 3, 29), "+02:00"), (dt.date(2026, 10, 25), "+01:00")],
+)
+def test_a_round_across_a_clock_change_keeps_true_time(date, offset_at_return):
+    # From 01:00 in Vienna across the daylight-saving change: every time shown is the
+    # departure plus the true elapsed seconds, in the offset then in force.
+    result = plan(
+        problem(round_of(6, service_time_s=1500), start_time=dt.time(1, 0)).model_copy(
+            update={"date": date}
+        )
+    )
+    depart = result.legs[0].depart
+    back = result.legs[-1].arrive
+    elapsed = back.astimezone(dt.UTC) - depart.astimezone(dt.UTC)
+    assert elapsed.total_seconds() == pytest.approx(result.duration_s)
+    assert back.isoformat().endswith(offset_at_return)
+    assert depart.isoformat().endswith("+01:00" if date.month == 3 else "+02:00")
+    for leg, stop in zip(result.legs, result.stops, strict=False):
+        assert stop.arrival == leg.arrive
+
+
+def test_each_day_of_a_round_past_midnight_gets_its_own_weather():
+    # In April the climatology warms by about 0.17 K a day.
+    april = dt.date(2026, 4, 15)
+    rounds = problem(round_of(3, service_time_s=3600), start_time=dt.time(22, 0))
+    result = plan(rounds.model_copy(update={"date": april}))
+    days = [april, april + dt.timedelta(days=1)]
+    assert [d.date for d in result.weather_days] == days
+    assert result.weather_source == "climatology"
+    assert [(d.t_min_c, d.t_max_c) for d in result.weather_days] == [
+        (w.t_min_c, w.t_max_c) for w in (climatology(day, DEPOT.lat) for day in days)
+    ]
+    assert result.weather_days[0].t_max_c < result.weather_days[1].t_max_c
+
+
+def test_delivering_the_whole_payload_is_no_false_alarm():
+    # Issue #10: a dynamic box emptied stop by stop reported 46.5 °C and 16.5 min above the
+    # limit. With the box's structure and the loads at its temperature it stays cold.
+    stops = round_of(8, door_open_s=120, delivery_kg=25)
+    van = VanParams(cargo_box=CargoBoxParams(mode="dynamic"), payload_kg=200)
+    result = plan(problem(stops, van=van, weather=Weather(t_min_c=18, t_max_c=31)))
+    assert result.stops[-1].payload_after_kg == 0
+    assert result.minutes_above_product_limit == 0
+    assert result.max_box_temperature_c < 7
+
+
+def test_cab_off_at_stops_saves_winter_energy():
+    stops = round_of(6, service_time_s=900)
+    cold = Weather(t_min_c=-8, t_max_c=-2)
+    on = plan(problem(stops, weather=cold, keep_order=True))
+    off_van = VanParams(vehicle=VehicleParams(cab_hvac_at_stops="off"))
+    off = plan(problem(stops, weather=cold, keep_order=True, van=off_van))
+    assert off.energy_kwh["cabin"] < on.energy_kwh["cabin"]
+    # parked, the HVAC draws nothing; after each stop it recovers the drift
+    assert all(stop.energy_kwh["cabin"] == 0 for stop in off.stops)
+    assert any(
+        leg.energy_kwh["cabin"] > on.legs[k].energy_kwh["cabin"]
+        for k, leg in enumerate(off.legs[1:], start=1)
+    )

@@ -4,6 +4,7 @@ import pytest
 from core.params import CargoBoxParams
 from core.solar import (
     absorbed_solar_heat_w,
+    direct_normal_from_horizontal_w_m2,
     declination_deg,
     direct_irradiance_w_m2,
     equation_of_time_min,
@@ -60,6 +61,20 @@ def test_absorbed_solar_heat_by_hand():
     # sun at 30° in January: S = 925.90 W/m²; κ* = 0.3 · 2.172/22.7 = 0.028705
     # roof 8 · 0.5 = 4; sides (2·4.182 + 3.12) · cos 30°/π = 11.484 · 0.27566 = 3.1657
     # (4 + 3.1657) · 925.90 · 0.028705 · 0.8 (shadow) = 152.34 W
-    assert absorbed_solar_heat_w(box, 0.5, 1) == pytest.approx(152.3, abs=0.2)
-    assert absorbed_solar_heat_w(box, -0.1, 1) == 0.0
-    assert absorbed_solar_heat_w(CargoBoxParams(shadow_factor=0.0), 0.5, 1) == 0.0
+    clear = direct_irradiance_w_m2(0.5, 1)
+    assert clear == pytest.approx(925.90, abs=0.05)
+    assert absorbed_solar_heat_w(box, 0.5, clear) == pytest.approx(152.3, abs=0.2)
+    assert absorbed_solar_heat_w(box, -0.1, clear) == 0.0
+    assert absorbed_solar_heat_w(CargoBoxParams(shadow_factor=0.0), 0.5, clear) == 0.0
+
+
+def test_forecast_sun_with_diffuse_by_hand():
+    box = CargoBoxParams()
+    # Forecast: 400 W/m² direct on the horizontal at 30° altitude → S = 800 W/m² normal;
+    # 100 W/m² diffuse. Roof 8 · (800 · 0.5 + 100) = 4000; sides 11.484 · (800 · cos 30°/π
+    # + 50) = 11.484 · 270.53 = 3106.8; (4000 + 3106.8) · 0.028705 · 0.8 = 163.20 W
+    direct = direct_normal_from_horizontal_w_m2(400.0, 0.5)
+    assert direct == pytest.approx(800.0)
+    assert absorbed_solar_heat_w(box, 0.5, direct, 100.0) == pytest.approx(163.20, abs=0.05)
+    # below 3° of altitude the direct part is dropped (forecast noise over a tiny sine)
+    assert direct_normal_from_horizontal_w_m2(5.0, 0.04) == 0.0

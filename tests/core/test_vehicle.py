@@ -7,6 +7,7 @@ from core.params import GRAVITY_MPS2, VehicleParams
 from core.vehicle import (
     drag_force_n,
     electric_power_w,
+    motor_limited_power_w,
     rolling_force_n,
     slope_force_n,
     step_traction_power_w,
@@ -91,3 +92,32 @@ def test_energy_rises_with_drag(speed, cd, factor):
     high_vehicle = VehicleParams(drag_coefficient=min(cd * factor, 2.0))
     high = step_traction_power_w(high_vehicle, speed, 1.0, MASS, 0.0).sum()
     assert high >= low - 1e-9 * abs(low)
+
+
+def test_headwind_drag_by_hand():
+    # eq. 3 with the speed through the air: 20 m/s into a 5 m/s headwind is drag at 25 m/s,
+    # ½ · 1.2 · 4.27 · 0.329 · 25² = 526.81 N; a 25 m/s tailwind on a van at 20 m/s pushes it
+    assert drag_force_n(VAN, 20.0, 5.0) == pytest.approx(526.811, rel=1e-5)
+    assert drag_force_n(VAN, 20.0, -25.0) == pytest.approx(-0.842898 * 25, rel=1e-5)
+    # standing still: no drag on the van's own power budget
+    assert traction_force_n(VAN, MASS, 0.0, 0.0, 0.0, 10.0) == 0.0
+
+
+def test_motor_cap_delivers_the_same_energy_later():
+    # A hard 0 → 25 m/s launch of 2230 kg at 2 m/s² asks for up to 110 kW at the wheels;
+    # capped at 50 kW the van lags and catches up while cruising: the same mechanical energy,
+    # never more than 50 kW.
+    capped = VehicleParams(max_motor_power_w=50_000, regen_efficiency=0)
+    speed = np.concatenate((np.arange(0, 25.5, 2.0), np.full(120, 25.0)))
+    free = step_traction_power_w(VAN.model_copy(update={"regen_efficiency": 0}), speed, 1, MASS, 0)
+    limited = step_traction_power_w(capped, speed, 1, MASS, 0)
+    assert free.max() * VAN.drivetrain_efficiency > 100_000
+    assert limited.max() == pytest.approx(50_000 / VAN.drivetrain_efficiency)
+    assert limited.sum() == pytest.approx(free.sum(), rel=1e-9)
+    assert motor_limited_power_w(VAN, np.array([1e9]), 1.0) == pytest.approx([1e9])  # no cap
+
+
+def test_regen_cap_limits_charging_power():
+    capped = VehicleParams(max_regen_power_w=20_000)
+    assert electric_power_w(capped, -100_000) == pytest.approx(-20_000)
+    assert electric_power_w(capped, -10_000) == pytest.approx(-6_000)  # 0.6 · 10 kW

@@ -1,0 +1,95 @@
+"""What the planner needs from outside services, as core types and protocols.
+
+The core never talks to the network. A road router (OSRM, :mod:`app.connectors.osrm`) and a
+weather service (:mod:`app.connectors.weather`) implement the protocols below and hand back
+plain arrays; the planner calls them at the right moment (the matrix before the tour, the routes
+of the chosen tour's legs, the forecast for the round's span).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from core.arrays import FloatArray
+from core.params import Depot
+from core.weather import HourlyWeather
+
+
+@dataclass(frozen=True)
+class RoadTable:
+    """A router's answer for every ordered pair of places (depot first).
+
+    Attributes
+    ----------
+    distance_m, duration_s
+        Road distance [m] and free-flow driving time [s] of each pair.
+    snap_distance_m
+        How far each place is from the road the router snapped it to [m].
+    """
+
+    distance_m: FloatArray
+    duration_s: FloatArray
+    snap_distance_m: FloatArray
+
+
+@dataclass(frozen=True)
+class LegRoute:
+    """The road of one leg, segment by segment.
+
+    Attributes
+    ----------
+    segment_distance_m, segment_speed_mps, segment_heading_deg
+        Length [m], the router's speed [m/s] and the direction of travel [°, 0 north] of each
+        segment, in driving order.
+    coordinates
+        The road's polyline, ``(lon, lat)`` [°] per row.
+    """
+
+    segment_distance_m: FloatArray
+    segment_speed_mps: FloatArray
+    segment_heading_deg: FloatArray
+    coordinates: FloatArray
+
+    @property
+    def distance_m(self) -> float:
+        """Length of the road [m]."""
+        return float(self.segment_distance_m.sum())
+
+
+class RoadRouter(Protocol):
+    """A road router: distances, durations and roads between places."""
+
+    name: str
+
+    def table(self, places: Sequence[Depot]) -> RoadTable:
+        """Distances and durations of every ordered pair; raises
+        :class:`core.exceptions.ServiceUnavailableError` when the router fails and
+        :class:`core.exceptions.InvalidStopsError` naming a stop it cannot use."""
+        ...
+
+    def route(self, origin: Depot, destination: Depot) -> LegRoute:
+        """The road from ``origin`` to ``destination``."""
+        ...
+
+
+class WeatherService(Protocol):
+    """An hourly forecast (or archive) at one place."""
+
+    def hourly(self, lat: float, lon: float, start: dt.datetime, end: dt.datetime) -> HourlyWeather:
+        """Hourly weather covering ``start``..``end`` (UTC-aware); raises
+        :class:`core.exceptions.ServiceUnavailableError` when it cannot."""
+        ...
+
+
+def bearing_deg(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Initial great-circle bearing from point 1 to point 2 [°, 0 north, 90 east]."""
+    phi1, phi2 = np.radians(lat1), np.radians(lat2)
+    dlam = np.radians(lon2 - lon1)
+    y = np.sin(dlam) * np.cos(phi2)
+    x = np.cos(phi1) * np.sin(phi2) - np.sin(phi1) * np.cos(phi2) * np.cos(dlam)
+    return float(np.degrees(np.arctan2(y, x)) % 360.0)
