@@ -4,7 +4,11 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: test bench serve openapi report lint clean
+OSRM := .router/osrm/bin/osrm-routed
+PBF ?=
+ROUTER_DIR ?= .router/region
+
+.PHONY: test bench serve openapi report lint clean router router-serve
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -14,14 +18,26 @@ $(STAMP): pyproject.toml
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/ruff format --check core app tests benchmarks
+	$(BIN)/ruff format --check core app tests benchmarks tools
 	$(BIN)/mypy core app
 
-test: lint
+# The OSRM programs from the pinned osrm-bindings wheel (tests run a real router on Monaco).
+$(OSRM): | $(STAMP)
+	$(BIN)/python -m tools.osrm install
+
+test: lint $(OSRM)
 	$(BIN)/python -m pytest
 
-bench: $(STAMP)
+bench: $(STAMP) $(OSRM)
 	$(BIN)/python -m benchmarks
+
+# A road router for your region: make router PBF=region.osm.pbf, then make router-serve.
+router: $(OSRM)
+	test -n "$(PBF)" || (echo "usage: make router PBF=region.osm.pbf" && false)
+	$(BIN)/python -m tools.osrm prepare "$(PBF)" --out $(ROUTER_DIR)
+
+router-serve: $(OSRM)
+	$(BIN)/python -m tools.osrm serve $(ROUTER_DIR) --port $${OSRM_PORT:-5000}
 
 serve: $(STAMP)
 	$(BIN)/uvicorn app.main:app --host $${COLDROUTE_HOST:-0.0.0.0} --port $${COLDROUTE_PORT:-8000}
@@ -33,4 +49,4 @@ report: $(STAMP)
 	$(BIN)/python -m app.report
 
 clean:
-	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) .router .pytest_cache .mypy_cache .ruff_cache

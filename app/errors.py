@@ -11,7 +11,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from core.exceptions import CoreError, LimitExceededError
+from core.exceptions import CoreError, LimitExceededError, ServiceUnavailableError
 
 PROBLEM_JSON = "application/problem+json"
 _log = logging.getLogger("coldroute")
@@ -67,6 +67,21 @@ async def _http(_: Request, error: Exception) -> JSONResponse:
     return problem(error.status_code, title, str(error.detail), headers=error.headers)
 
 
+#: Seconds a client should wait before retrying after an outside service failed.
+SERVICE_RETRY_AFTER_S = 30
+
+
+async def _service(_: Request, error: Exception) -> JSONResponse:
+    assert isinstance(error, ServiceUnavailableError)
+    return problem(
+        503,
+        "Service unavailable",
+        error.message,
+        headers={"Retry-After": str(SERVICE_RETRY_AFTER_S)},
+        service=error.service,
+    )
+
+
 async def _unexpected(_: Request, error: Exception) -> JSONResponse:
     _log.exception("unexpected error", exc_info=error)
     return problem(500, "Internal error", "An unexpected error occurred; it has been logged.")
@@ -76,5 +91,6 @@ def install(app: FastAPI) -> None:
     """Register the problem handlers on ``app``."""
     app.add_exception_handler(RequestValidationError, _validation)
     app.add_exception_handler(CoreError, _core)
+    app.add_exception_handler(ServiceUnavailableError, _service)
     app.add_exception_handler(StarletteHTTPException, _http)
     app.add_exception_handler(Exception, _unexpected)

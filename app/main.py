@@ -7,15 +7,17 @@ import logging
 import secrets
 import time
 from importlib.metadata import version
-from typing import Annotated
+from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, FastAPI, Header, HTTPException
 from fastapi.middleware.cors import CORSMiddleware
+from pydantic import BaseModel
+from pydantic.json_schema import models_json_schema
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from app import errors
 from app.routers import health, plans, presets, simulate, studies
-from app.schemas import Problem
+from app.schemas import PlanFeatureCollection, Problem
 from app.settings import Settings, get_settings
 
 _log = logging.getLogger("coldroute.requests")
@@ -134,6 +136,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """The ASGI application; ``settings`` overrides the environment (tests)."""
     settings = settings or get_settings()
     logging.basicConfig(level=settings.log_level.upper(), format="%(message)s")
+    # One line per request is ours to write; the router and weather calls are not news.
+    logging.getLogger("httpx").setLevel(logging.WARNING)
     app = FastAPI(
         title="coldroute",
         version=version("coldroute"),
@@ -168,7 +172,27 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         )
     app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
     app.add_middleware(RequestLog)
+    _add_response_schemas(app, [PlanFeatureCollection])
     return app
+
+
+def _add_response_schemas(app: FastAPI, models: list[type[BaseModel]]) -> None:
+    """Put models that operations reference by ``$ref`` only (alternative media types) into
+    the OpenAPI components."""
+    generate = app.openapi
+
+    def openapi() -> dict[str, Any]:
+        if app.openapi_schema is None:
+            schema = generate()
+            _, definitions = models_json_schema(
+                [(model, "serialization") for model in models],
+                ref_template="#/components/schemas/{model}",
+            )
+            schema["components"]["schemas"].update(definitions.get("$defs", {}))
+            app.openapi_schema = schema
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
 
 
 app = create_app()

@@ -23,6 +23,7 @@ from app.examples import PLAN_EXAMPLE
 from app.routers.plans import plan_problem
 from app.schemas import PlanRequest
 from app.settings import get_settings
+from core.clock import departure
 from core.cycles import generate_leg
 from core.params import (
     AGGRESSIVE_DRIVER,
@@ -33,7 +34,7 @@ from core.params import (
     Location,
     Weather,
 )
-from core.plan import PlanProblem, PlanResult, departure, plan
+from core.plan import PlanProblem, PlanResult, plan
 from core.simulate import CONSUMERS, simulate
 from core.studies import Season, scenario_grid, speed_sweep
 

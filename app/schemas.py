@@ -23,6 +23,7 @@ from core.params import (
     CargoBoxParams,
     Depot,
     DoorOpening,
+    Interval,
     Location,
     Objective,
     Params,
@@ -114,6 +115,11 @@ class VanRequest(ApiModel):
     payload_kg: float | None = Field(
         None, ge=0, le=40_000, description="Payload at departure [kg]; preset value if absent."
     )
+    precondition_at_depot: bool | None = Field(
+        None,
+        description=f"{VanParams.model_fields['precondition_at_depot'].description} Preset "
+        "value if absent.",
+    )
 
     def van(self) -> VanParams:
         """The preset with this request's changes applied, validated by the core models; an
@@ -135,7 +141,12 @@ class VanRequest(ApiModel):
                 field = f"{section}.{error.field}" if error.field else section
                 raise InvalidParameterError(message, field) from None
         payload = preset.payload_kg if self.payload_kg is None else self.payload_kg
-        return VanParams(**built, payload_kg=payload)
+        precondition = (
+            preset.precondition_at_depot
+            if self.precondition_at_depot is None
+            else self.precondition_at_depot
+        )
+        return VanParams(**built, payload_kg=payload, precondition_at_depot=precondition)
 
 
 class PlanRequest(VanRequest):
@@ -167,6 +178,11 @@ class PlanRequest(VanRequest):
     time_limit_s: float = Field(
         1.0, gt=0, le=600, description="Solver budget [s], capped by the server's setting."
     )
+    include_geometry: bool = Field(
+        False,
+        description="Return each leg's road as a GeoJSON LineString in legs[].geometry (the "
+        "router's road with OSRM, else the straight line).",
+    )
 
 
 class EnergyKwh(ApiModel):
@@ -188,6 +204,22 @@ class EnergyShare(ApiModel):
     refrigeration: float
 
 
+class LineString(ApiModel):
+    """A GeoJSON LineString (RFC 7946): positions as [longitude, latitude]."""
+
+    type: Literal["LineString"] = "LineString"
+    coordinates: list[tuple[float, float]] = Field(
+        ..., description="Positions [lon, lat] in degrees (WGS 84)."
+    )
+
+
+class Point(ApiModel):
+    """A GeoJSON Point (RFC 7946)."""
+
+    type: Literal["Point"] = "Point"
+    coordinates: tuple[float, float] = Field(..., description="[lon, lat] in degrees (WGS 84).")
+
+
 class LegOut(ApiModel):
     """One driven leg."""
 
@@ -202,6 +234,9 @@ class LegOut(ApiModel):
     energy_kwh: EnergyKwh
     soc_start: float = Field(..., description="State of charge at departure [–].")
     soc_end: float = Field(..., description="State of charge on arrival [–].")
+    geometry: LineString | None = Field(
+        None, description="The leg's road; present when the request sets include_geometry."
+    )
 
 
 class StopOut(ApiModel):
@@ -215,6 +250,11 @@ class StopOut(ApiModel):
     energy_kwh: EnergyKwh = Field(..., description="Energy used while standing here [kWh].")
     soc_arrival: float
     soc_departure: float
+    snap_distance_m: float | None = Field(
+        None,
+        description="Distance from the stop to the road the router snapped it to [m]; null "
+        "without a router.",
+    )
 
 
 class Totals(ApiModel):
@@ -224,6 +264,11 @@ class Totals(ApiModel):
     duration_s: float = Field(..., description="From departure to return, stops included [s].")
     energy_kwh: EnergyKwh
     energy_share: EnergyShare
+    grid_kwh: float = Field(
+        0.0,
+        description="Energy from the grid before departure to pre-condition cab and box [kWh] "
+        "(not from the battery).",
+    )
 
 
 class BatteryOut(ApiModel):
@@ -234,6 +279,18 @@ class BatteryOut(ApiModel):
     final_soc: float = Field(..., description="State of charge at the end [–].")
     margin_kwh: float = Field(..., description="Energy above the reserve at the lowest point.")
     required_capacity_kwh: float = Field(..., description="Smallest usable capacity that works.")
+    usable_capacity_kwh: float | None = Field(
+        None, description="Usable capacity on the day, after temperature derating [kWh]."
+    )
+    temperature_loss_kwh: float = Field(
+        0.0,
+        description="Battery energy beyond the consumers' lost to cold or heat "
+        "(temperature derating) [kWh].",
+    )
+    recharge_kwh: float | None = Field(
+        None,
+        description="Grid energy to recharge the battery to its initial state of charge [kWh].",
+    )
     first_infeasible_leg: int | None = Field(
         None,
         description="Index in legs[] of the leg (or the stop after it) that breaks the "
@@ -241,12 +298,27 @@ class BatteryOut(ApiModel):
     )
 
 
-class WeatherOut(ApiModel):
-    """The day's temperatures used."""
+class DayWeatherOut(ApiModel):
+    """One local day's temperatures."""
 
-    t_min_c: float
-    t_max_c: float
-    source: WeatherSource = Field(..., description="'request' or 'climatology'.")
+    date: dt.date
+    t_min_c: float = Field(..., description="Lowest temperature of the day's moments [°C].")
+    t_max_c: float = Field(..., description="Highest temperature of the day's moments [°C].")
+
+
+class WeatherOut(ApiModel):
+    """The temperatures used."""
+
+    t_min_c: float = Field(..., description="Lowest temperature of the first day [°C].")
+    t_max_c: float = Field(..., description="Highest temperature of the first day [°C].")
+    source: WeatherSource = Field(
+        ...,
+        description="'request' (the request's weather), 'forecast' or 'archive' (the weather "
+        "service's hourly data) or 'climatology'.",
+    )
+    days: list[DayWeatherOut] = Field(
+        default_factory=list, description="Each local day of a round, with its own weather."
+    )
 
 
 class BoxOut(ApiModel):
@@ -277,6 +349,37 @@ class PlanResponse(ApiModel):
     timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
     box: BoxOut
     solver: SolverOut
+    distance_source: Literal["osrm", "client", "estimate"] = Field(
+        ...,
+        description="Where the legs' distances and durations came from: the OSRM router, the "
+        "request's matrix, or the great-circle estimate.",
+    )
+    warnings: list[str] = Field(
+        default_factory=list,
+        description="What the plan had to do without (e.g. the weather service was down and "
+        "the climatology was used).",
+    )
+    attribution: str | None = Field(
+        None, description="Credit for the map data the legs were routed on."
+    )
+
+
+class Feature(ApiModel):
+    """A GeoJSON Feature (RFC 7946)."""
+
+    type: Literal["Feature"] = "Feature"
+    geometry: Point | LineString
+    properties: dict[str, Any] = Field(..., description="What the feature is, with its figures.")
+
+
+class PlanFeatureCollection(ApiModel):
+    """The plan as a GeoJSON FeatureCollection: the depot and stops as Points (id, arrival,
+    door heat, state of charge), the legs as LineStrings (energy per consumer, state of charge
+    at both ends)."""
+
+    type: Literal["FeatureCollection"] = "FeatureCollection"
+    features: list[Feature]
+    attribution: str | None = Field(None, description="Credit for the map data.")
 
 
 class CycleRequest(ApiModel):
@@ -302,10 +405,17 @@ class SimulateRequest(VanRequest):
     start: AwareDatetime = Field(..., description="Start time, ISO 8601 with UTC offset.")
     location: Location = Field(..., description="Where the van drives (sun, climatology).")
     weather: Weather | None = Field(
-        None, description="The day's forecast; absent: the climatology for date and latitude."
+        None,
+        description="The day's extremes; absent: the weather service's hourly forecast when "
+        "the server has one, else the climatology for date and latitude.",
     )
     door_openings: list[DoorOpening] = Field(
         default_factory=list, description="Cargo-door openings, seconds after the start."
+    )
+    parked: list[Interval] = Field(
+        default_factory=list,
+        description="When the van stands at a stop, seconds after the start: the cab HVAC's "
+        "duty while parked (vehicle.cab_hvac_at_stops).",
     )
     include_series: bool = Field(False, description="Return the time series too.")
 
@@ -439,6 +549,12 @@ class SimulateResponse(ApiModel):
     weather: WeatherOut
     box: BoxOut
     series: Series | None = None
+    grid_kwh: float = Field(
+        0.0, description="Energy from the grid to pre-condition cab and box before the start."
+    )
+    warnings: list[str] = Field(
+        default_factory=list, description="What the simulation had to do without."
+    )
 
 
 class PresetsResponse(ApiModel):

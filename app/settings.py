@@ -33,6 +33,37 @@ class Settings(BaseSettings):
     max_time_limit_s: float = Field(
         10.0, gt=0, description="Cap on a request's solver time_limit_s [s]."
     )
+    osrm_url: str | None = Field(
+        None,
+        description="Base URL of an OSRM router (http://127.0.0.1:5000); unset: distances are "
+        "estimated from the great circle.",
+    )
+    osrm_timeout_s: float = Field(10.0, gt=0, le=300, description="Timeout of one OSRM call [s].")
+    osrm_table_size: int = Field(
+        100,
+        ge=2,
+        le=10_000,
+        description="Most places per side of one OSRM /table call (the server's "
+        "--max-table-size); larger rounds are fetched in blocks.",
+    )
+    max_snap_distance_m: float = Field(
+        500.0,
+        gt=0,
+        description="Farthest a stop may lie from the road OSRM snaps it to [m] (422 beyond).",
+    )
+    weather_url: str | None = Field(
+        None,
+        description="Base URL of an Open-Meteo-compatible forecast API "
+        "(https://api.open-meteo.com); unset: the climatology.",
+    )
+    weather_archive_url: str | None = Field(
+        None,
+        description="Base URL of its archive API for past dates "
+        "(https://archive-api.open-meteo.com); unset: the same as weather_url.",
+    )
+    weather_timeout_s: float = Field(
+        5.0, gt=0, le=120, description="Timeout of one weather call [s]."
+    )
 
 
 @lru_cache

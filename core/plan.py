@@ -22,13 +22,12 @@ from pydantic import Field
 
 from core.arrays import FloatArray
 from core.battery import JOULES_PER_KWH, BatteryVerdict
-from core.clock import UTC, at, check_representable, departure
+from core.clock import at, check_representable, departure
 from core.cycles import drive_profile, generate_leg, stretch_to_duration, trace_distance_m
 from core.exceptions import (
     InvalidStopsError,
     LimitExceededError,
     NoRouteError,
-    ServiceUnavailableError,
 )
 from core.geo import (
     MAX_LEG_GRADE,
@@ -53,11 +52,11 @@ from core.params import (
     VanParams,
     Weather,
 )
-from core.roads import LegRoute, RoadRouter, WeatherService, bearing_deg
+from core.roads import LegRoute, RoadRouter, bearing_deg
 from core.simulate import CONSUMERS, SimulationResult, simulate
 from core.tsp import SolverStatus, solve_tour
 from core.vehicle import step_traction_power_w
-from core.weather import DayWeather, Forecast, WeatherSource
+from core.weather import DayWeather, WeatherService, WeatherSource, forecast_for
 
 #: Sampling interval of the day's simulation [s].
 PLAN_DT_S = 1.0
@@ -223,7 +222,14 @@ def plan(
     )
     timeline = _timeline(problem, places, legs, order, routes)
     check_representable(start, timeline.speed.size * PLAN_DT_S, "date")
-    weather, warnings = _weather(problem, weather_service, start, timeline.speed.size * PLAN_DT_S)
+    weather, warnings = forecast_for(
+        problem.weather,
+        weather_service,
+        problem.depot.lat,
+        problem.depot.lon,
+        start,
+        timeline.speed.size * PLAN_DT_S,
+    )
     result = simulate(
         timeline.speed,
         PLAN_DT_S,
@@ -267,28 +273,6 @@ def _routes(router: RoadRouter, places: list[Depot], order: list[int]) -> list[L
 def _place_field(index: int) -> str:
     """The request field of place ``index`` (0 the depot)."""
     return "depot" if index == 0 else f"stops[{index - 1}]"
-
-
-def _weather(
-    problem: PlanProblem, service: WeatherService | None, start: dt.datetime, span_s: float
-) -> tuple[Forecast | None, list[str]]:
-    """The request's weather, else the service's forecast for the span, else None (the
-    climatology) with a warning when the service failed."""
-    if problem.weather is not None or service is None:
-        return problem.weather, []
-    begin = start.astimezone(UTC)
-    try:
-        return (
-            service.hourly(
-                problem.depot.lat, problem.depot.lon, begin, begin + dt.timedelta(seconds=span_s)
-            ),
-            [],
-        )
-    except ServiceUnavailableError as error:
-        return None, [
-            f"weather service unavailable ({error.message}); planned on the climatology for "
-            "the date and latitude"
-        ]
 
 
 def _check_stops(problem: PlanProblem) -> None:

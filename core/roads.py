@@ -1,14 +1,13 @@
-"""What the planner needs from outside services, as core types and protocols.
+"""What the planner needs from a road router, as core types and a protocol.
 
-The core never talks to the network. A road router (OSRM, :mod:`app.connectors.osrm`) and a
-weather service (:mod:`app.connectors.weather`) implement the protocols below and hand back
-plain arrays; the planner calls them at the right moment (the matrix before the tour, the routes
-of the chosen tour's legs, the forecast for the round's span).
+The core never talks to the network. A road router (OSRM, :mod:`app.connectors.osrm`)
+implements :class:`RoadRouter` and hands back plain arrays; the planner calls it at the right
+moment (the matrix before the tour, the roads of the chosen tour's legs). The weather service's
+protocol is :class:`core.weather.WeatherService`.
 """
 
 from __future__ import annotations
 
-import datetime as dt
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -17,7 +16,6 @@ import numpy as np
 
 from core.arrays import FloatArray
 from core.params import Depot
-from core.weather import HourlyWeather
 
 
 @dataclass(frozen=True)
@@ -74,15 +72,6 @@ class RoadRouter(Protocol):
 
     def route(self, origin: Depot, destination: Depot) -> LegRoute:
         """The road from ``origin`` to ``destination``."""
-        ...
-
-
-class WeatherService(Protocol):
-    """An hourly forecast (or archive) at one place."""
-
-    def hourly(self, lat: float, lon: float, start: dt.datetime, end: dt.datetime) -> HourlyWeather:
-        """Hourly weather covering ``start``..``end`` (UTC-aware); raises
-        :class:`core.exceptions.ServiceUnavailableError` when it cannot."""
         ...
 
 

@@ -27,8 +27,9 @@ from core.params import (
     Weather,
 )
 from core.plan import PlanProblem, PlanResult, plan
-from core.roads import LegRoute, RoadRouter, RoadTable, WeatherService
+from core.roads import LegRoute, RoadRouter, RoadTable
 from core.simulate import CONSUMERS, simulate
+from core.weather import WeatherService
 
 #: Shortest swept trip [m]: shorter ones are all ramp and say nothing about a cruising speed.
 MIN_SWEEP_DISTANCE_M = 100.0

@@ -16,14 +16,14 @@ from __future__ import annotations
 import datetime as dt
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from core.arrays import FloatArray
 from core.clock import LocalClock
-from core.exceptions import InvalidParameterError
+from core.exceptions import InvalidParameterError, ServiceUnavailableError
 from core.params import Weather
 
 WeatherSource = Literal["request", "forecast", "archive", "climatology"]
@@ -258,3 +258,37 @@ def headwind_mps(
     heading = np.radians(heading_deg)
     head = wind_from_east_mps * np.sin(heading) + wind_from_north_mps * np.cos(heading)
     return np.where(np.isfinite(head), head, 0.0)
+
+
+class WeatherService(Protocol):
+    """An hourly forecast (or archive) at one place."""
+
+    def hourly(self, lat: float, lon: float, start: dt.datetime, end: dt.datetime) -> HourlyWeather:
+        """Hourly weather covering ``start``..``end`` (UTC-aware); raises
+        :class:`core.exceptions.ServiceUnavailableError` when it cannot."""
+        ...
+
+
+def forecast_for(
+    requested: Weather | None,
+    service: WeatherService | None,
+    lat: float,
+    lon: float,
+    start: dt.datetime,
+    span_s: float,
+) -> tuple[Forecast | None, list[str]]:
+    """The weather to simulate ``span_s`` seconds from ``start`` with, and any warning.
+
+    The request's own weather wins; else the service's hourly forecast; else None (the
+    climatology) — with a warning when the service was asked and failed.
+    """
+    if requested is not None or service is None:
+        return requested, []
+    begin = start.astimezone(dt.UTC)
+    try:
+        return service.hourly(lat, lon, begin, begin + dt.timedelta(seconds=span_s)), []
+    except ServiceUnavailableError as error:
+        return None, [
+            f"weather service unavailable ({error.message}); used the climatology for the "
+            "date and latitude"
+        ]

@@ -1,12 +1,17 @@
-"""Shared test fixtures: paths to the reference data beside the repository."""
+"""Shared test fixtures: the reference data beside the repository, a real OSRM router on the
+Monaco extract and the local weather-API stand-in."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+from tests.weather_stub import StubServer
+from tools import osrm
 
 # CI replays the same examples every run (a red CI must be reproducible); developers' runs
 # keep exploring new ones.
@@ -22,3 +27,23 @@ def reference_dir() -> Path:
     if not SHARED.is_dir():
         pytest.fail(f"reference data not found at {SHARED}: clone with ../shared beside the repo")
     return SHARED
+
+
+@pytest.fixture(scope="session")
+def monaco_osrm(reference_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The Monaco extract prepared for OSRM's car profile (about 1 s)."""
+    return osrm.prepare(reference_dir / "osm" / "monaco.osm.pbf", tmp_path_factory.mktemp("osrm"))
+
+
+@pytest.fixture(scope="session")
+def osrm_url(monaco_osrm: Path) -> Iterator[str]:
+    """A real osrm-routed on the Monaco extract for the whole session."""
+    with osrm.running(monaco_osrm) as url:
+        yield url
+
+
+@pytest.fixture(scope="session")
+def weather_stub() -> Iterator[StubServer]:
+    server = StubServer()
+    yield server
+    server.shutdown()

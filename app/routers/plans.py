@@ -2,27 +2,21 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Depends
+from fastapi import APIRouter, Body, Depends, Header
+from fastapi.responses import JSONResponse
 
+from app import connectors
 from app.examples import PLAN_EXAMPLE
-from app.routers import results
-from app.schemas import (
-    EnergyShare,
-    LegOut,
-    PlanRequest,
-    PlanResponse,
-    SolverOut,
-    StopOut,
-    Totals,
-    clock_time,
-)
+from app.routers.results import plan_geojson, plan_response
+from app.schemas import PlanRequest, PlanResponse, clock_time
 from app.settings import Settings, get_settings
 from core.exceptions import LimitExceededError
-from core.plan import PlanProblem, plan
+from core.plan import PlanProblem, PlanResult, plan
 
 router = APIRouter(tags=["plans"])
+GEOJSON = "application/geo+json"
 
 
 def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
@@ -49,7 +43,50 @@ def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
     )
 
 
-@router.post("/plans", operation_id="createPlan", summary="Plan and simulate a delivery round")
+def run_plan(request: PlanRequest, settings: Settings) -> PlanResult:
+    """Plan a request with the configured road router and weather service."""
+    return plan(
+        plan_problem(request, settings),
+        connectors.router(settings),
+        connectors.weather_service(settings),
+    )
+
+
+def wants_geojson(accept: str | None) -> bool:
+    """Whether the Accept header prefers GeoJSON over plain JSON (RFC 9110 quality values)."""
+    if not accept:
+        return False
+    quality: dict[str, float] = {}
+    for part in accept.split(","):
+        media, *params = (p.strip() for p in part.split(";"))
+        q = 1.0
+        for param in params:
+            if param.startswith("q="):
+                try:
+                    q = float(param[2:])
+                except ValueError:
+                    q = 0.0
+        quality[media.lower()] = max(q, quality.get(media.lower(), 0.0))
+    geo = quality.get(GEOJSON, 0.0)
+    plain = max(quality.get("application/json", 0.0), quality.get("*/*", 0.0) * 0.999)
+    return geo > 0 and geo >= plain
+
+
+@router.post(
+    "/plans",
+    operation_id="createPlan",
+    summary="Plan and simulate a delivery round",
+    response_model=PlanResponse,
+    responses={
+        200: {
+            "description": "The planned round; as a GeoJSON FeatureCollection when the request "
+            "accepts application/geo+json.",
+            "content": {
+                GEOJSON: {"schema": {"$ref": "#/components/schemas/PlanFeatureCollection"}}
+            },
+        }
+    },
+)
 def create_plan(
     request: Annotated[
         PlanRequest,
@@ -63,34 +100,16 @@ def create_plan(
         ),
     ],
     settings: Annotated[Settings, Depends(get_settings)],
-) -> PlanResponse:
+    accept: Annotated[
+        str | None,
+        Header(description="application/json (default) or application/geo+json for a map."),
+    ] = None,
+) -> Any:
     """Orders the stops (OR-Tools), simulates every leg and stop with the paper's model and says
-    whether the battery holds out. Runs in a worker thread, off the event loop."""
-    result = plan(plan_problem(request, settings))
-    return PlanResponse(
-        tour=result.tour,
-        legs=[
-            LegOut(**(vars(leg) | {"energy_kwh": results.energy(leg.energy_kwh)}))
-            for leg in result.legs
-        ],
-        stops=[
-            StopOut(**(vars(stop) | {"energy_kwh": results.energy(stop.energy_kwh)}))
-            for stop in result.stops
-        ],
-        totals=Totals(
-            distance_m=result.distance_m,
-            duration_s=result.duration_s,
-            energy_kwh=results.energy(result.energy_kwh),
-            energy_share=EnergyShare(**result.energy_share),
-        ),
-        battery=results.battery(result.battery, result.first_infeasible_leg),
-        weather=results.weather(result.weather, result.weather_source),
-        timezone=result.timezone,
-        box=results.box(result.max_box_temperature_c, result.minutes_above_product_limit),
-        solver=SolverOut(
-            status=result.solver_status,
-            objective=result.objective,
-            objective_value=result.objective_value,
-            runtime_s=result.solver_runtime_s,
-        ),
-    )
+    whether the battery holds out. With `COLDROUTE_OSRM_URL` set, distances, durations and each
+    leg's speed profile come from the OSRM road router."""
+    result = run_plan(request, settings)
+    if wants_geojson(accept):
+        collection = plan_geojson(result, request.depot.lat, request.depot.lon)
+        return JSONResponse(collection.model_dump(mode="json"), media_type=GEOJSON)
+    return plan_response(result, request.include_geometry)

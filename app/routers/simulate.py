@@ -7,6 +7,7 @@ from typing import Annotated
 import numpy as np
 from fastapi import APIRouter, Body, Depends
 
+from app import connectors
 from app.examples import SIMULATE_EXAMPLE, SIMULATE_TRACE_EXAMPLE
 from app.routers import results
 from app.schemas import ConsumptionWhPerKm, PowerSeries, Series, SimulateRequest, SimulateResponse
@@ -14,7 +15,8 @@ from app.settings import Settings, get_settings
 from core.cycles import generate_leg
 from core.exceptions import LimitExceededError
 from core.params import STREET_TYPES
-from core.simulate import simulate
+from core.simulate import check_trace, simulate
+from core.weather import forecast_for
 
 router = APIRouter(tags=["simulation"])
 #: Shortest distance for which energy per km is reported [m].
@@ -69,6 +71,15 @@ def simulate_trace(
             f"{settings.max_trace_samples}",
             "speed_mps" if request.cycle is None else "cycle.distance_m",
         )
+    check_trace(speed, request.dt_s)  # before asking the weather service for its span
+    weather, warnings = forecast_for(
+        request.weather,
+        connectors.weather_service(settings),
+        request.location.lat,
+        request.location.lon,
+        request.start,
+        (speed.size - 1) * request.dt_s,
+    )
     result = simulate(
         speed,
         request.dt_s,
@@ -76,8 +87,9 @@ def simulate_trace(
         request.location,
         van,
         grade=request.grade,
-        weather=request.weather,
+        weather=weather,
         door_openings=request.door_openings,
+        parked=request.parked,
     )
     km = result.distance_m / 1000
     # Per-km figures of a trace that (nearly) stands still mean nothing: null below a metre.
@@ -97,11 +109,13 @@ def simulate_trace(
         duration_s=result.duration_s,
         energy_kwh=results.energy(result.energy_kwh),
         consumption_wh_per_km=ConsumptionWhPerKm(**per_km),
-        battery=results.battery(result.battery, None),
-        weather=results.weather(result.weather, result.weather_source),
+        battery=results.battery(result.battery, None, result.battery_loss_kwh),
+        weather=results.weather(result.weather, result.weather_source, result.weather_days),
         box=results.box(
             result.box.max_temperature_c if dynamic else None,
             result.box.minutes_above_limit if dynamic else None,
         ),
         series=series,
+        grid_kwh=result.grid_kwh,
+        warnings=warnings,
     )

@@ -6,6 +6,7 @@ from typing import Annotated
 
 from fastapi import APIRouter, Body, Depends
 
+from app import connectors
 from app.examples import SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
 from app.routers import results
 from app.routers.plans import plan_problem
@@ -20,8 +21,8 @@ from app.schemas import (
     clock_time,
 )
 from app.settings import Settings, get_settings
+from core.clock import departure
 from core.exceptions import LimitExceededError
-from core.plan import departure
 from core.studies import default_seasons, scenario_grid, speed_sweep
 
 router = APIRouter(prefix="/studies", tags=["studies"])
@@ -101,6 +102,8 @@ def run_scenarios(
         seasons,
         request.driver_aggressiveness,
         request.traffic_density,
+        router=connectors.router(settings),
+        weather_service=connectors.weather_service(settings),
     )
     return ScenariosResponse(
         tour=grid.tour,

@@ -37,7 +37,15 @@ def test_swagger_example_runs_as_is(client):
         + sum(stop["energy_kwh"]["total"] for stop in body["stops"])
     )
     assert body["battery"]["feasible"] is True and body["battery"]["first_infeasible_leg"] is None
-    assert body["weather"] == {"t_min_c": 18, "t_max_c": 31, "source": "request"}
+    assert body["weather"] == {
+        "t_min_c": 18,
+        "t_max_c": 31,
+        "source": "request",
+        "days": [{"date": "2026-07-15", "t_min_c": 18, "t_max_c": 31}],
+    }
+    assert body["distance_source"] == "estimate" and body["attribution"] is None
+    assert body["warnings"] == [] and body["totals"]["grid_kwh"] > 0
+    assert all(leg["geometry"] is None for leg in body["legs"])
     assert body["solver"]["status"] == "optimal" and body["solver"]["objective"] == "energy"
     assert body["stops"][-1]["payload_after_kg"] == pytest.approx(550 - 210)
 

@@ -4,9 +4,9 @@ import pytest
 from core.params import CargoBoxParams
 from core.solar import (
     absorbed_solar_heat_w,
-    direct_normal_from_horizontal_w_m2,
     declination_deg,
     direct_irradiance_w_m2,
+    direct_normal_from_horizontal_w_m2,
     equation_of_time_min,
     sin_altitude,
     solar_time_h,
