@@ -18,8 +18,8 @@ $(STAMP): pyproject.toml
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/ruff format --check core app tests benchmarks tools
-	$(BIN)/mypy core app
+	$(BIN)/ruff format --check core app tests benchmarks tools report
+	$(BIN)/mypy core app report
 
 # The OSRM programs from the pinned osrm-bindings wheel (tests run a real router on Monaco).
 $(OSRM): | $(STAMP)
@@ -46,7 +46,7 @@ openapi: $(STAMP)
 	$(BIN)/python -m app.openapi > openapi/openapi.json
 
 report: $(STAMP)
-	$(BIN)/python -m app.report
+	$(BIN)/python -m report.paper
 
 clean:
 	rm -rf $(VENV) .router .pytest_cache .mypy_cache .ruff_cache

@@ -252,8 +252,12 @@ def drive_profile(
     cell_s = np.diff(grid) / np.maximum(mean_cell, 1e-3)
     clock = np.concatenate(([0.0], np.cumsum(cell_s)))
     samples = np.arange(0.0, clock[-1] + dt_s, dt_s)
-    trace = np.interp(samples, clock, speed)
+    trace: FloatArray = np.interp(samples, clock, speed)
     trace[-1] = 0.0
+    if trace_distance_m(trace, dt_s) == 0:  # a hop shorter than one sample: the plain ramp
+        trace = generate_leg(
+            total, street, driver_aggressiveness, max_acceleration_mps2, None, dt_s
+        )
     trace *= total / trace_distance_m(trace, dt_s)
     travelled = np.concatenate(([0.0], np.cumsum(0.5 * (trace[:-1] + trace[1:]) * dt_s)))
     return trace, travelled

@@ -129,6 +129,9 @@ class OsrmRouter:
         snap: np.ndarray,
     ) -> None:
         members = sorted(set(rows) | set(cols))
+        if len(members) == 1:  # one place to itself: the diagonal (its snap comes with others)
+            distance[members[0], members[0]] = duration[members[0], members[0]] = 0.0
+            return
         position = {place: k for k, place in enumerate(members)}
         coordinates = ";".join(f"{places[i].lon:.6f},{places[i].lat:.6f}" for i in members)
         body = self._get(

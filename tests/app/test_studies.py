@@ -4,7 +4,7 @@ import sys
 import pytest
 
 from app.examples import SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
-from app.report import main as report_main
+from report.paper import main as report_main
 
 
 def test_speed_sweep_example(client):
@@ -73,7 +73,7 @@ def test_report_writes_page_and_charts(tmp_path):
 
 def test_report_cli_runs(tmp_path):
     run = subprocess.run(
-        [sys.executable, "-m", "app.report", "--out", str(tmp_path), "--quick"],
+        [sys.executable, "-m", "report.paper", "--out", str(tmp_path), "--quick"],
         capture_output=True,
         text=True,
         timeout=120,

@@ -188,3 +188,10 @@ def test_road_profile_rejects_bad_segments():
     # a router's zero or absurd speed is clamped, not trusted
     trace, _ = drive_profile(np.array([100.0, 100]), np.array([0.0, 1e6]), STEADY, 0.5, 2.0)
     assert trace.max() <= 60.0 and trace_distance_m(trace, 1.0) == pytest.approx(200.0)
+
+
+def test_a_hop_shorter_than_one_sample_still_moves():
+    trace, travelled = drive_profile(np.array([0.4]), np.array([12.0]), STEADY, 0.5, 2.0)
+    assert trace[0] == trace[-1] == 0 and trace.size >= 3
+    assert trace_distance_m(trace, 1.0) == pytest.approx(0.4)
+    assert travelled[-1] == pytest.approx(0.4)

@@ -1,0 +1,1 @@
+"""Documentation generators: `make report` writes docs/paper-reproduction.md."""
