@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -33,57 +34,55 @@ def reflected_cumsum(increments: ArrayLike, initial: float = 0.0) -> FloatArray:
     return s - np.minimum(np.minimum.accumulate(s, axis=-1), -initial) if s.size else s
 
 
-def interval_fraction(
-    starts_s: ArrayLike, durations_s: ArrayLike, step_end_s: FloatArray, dt_s: float
+def interval_rates(
+    starts_s: ArrayLike,
+    ends_s: ArrayLike,
+    n_steps: int,
+    dt_s: float,
+    rates: ArrayLike | None = None,
+    overlap: str = "max",
 ) -> FloatArray:
-    """Share of each step [–] covered by at least one interval ``[start, start + duration)``.
+    """Mean rate over each step of a set of boxcars; step ``k`` spans ``[k·dt, (k+1)·dt)``.
 
-    The covered time up to ``t`` is piecewise linear in ``t`` (slope 1 while any interval is
-    under way, so overlaps count once); it is built from the sorted start and end events and
-    read at the step edges with one interpolation. Its difference over a step, divided by the
-    step length, is the share.
-
-    Parameters
-    ----------
-    starts_s, durations_s
-        The intervals [s].
-    step_end_s
-        End of each step [s], equally spaced by ``dt_s``.
-    """
-    start = np.asarray(starts_s, dtype=float)
-    if start.size == 0:
-        return np.zeros(step_end_s.size)
-    end = start + np.asarray(durations_s, dtype=float)
-    events = np.concatenate((start, end))
-    order = np.argsort(events, kind="stable")
-    events = events[order]
-    under_way = np.cumsum(np.concatenate((np.ones(start.size), -np.ones(end.size)))[order])
-    slope = (under_way > 0).astype(float)
-    covered = np.concatenate(([0.0], np.cumsum(np.diff(events) * slope[:-1])))
-    edges = np.concatenate(([step_end_s[0] - dt_s], step_end_s))
-    return np.clip(np.diff(np.interp(edges, events, covered)) / dt_s, 0.0, 1.0)
-
-
-def rate_integral(
-    starts_s: ArrayLike, ends_s: ArrayLike, rates: ArrayLike, edges_s: FloatArray
-) -> FloatArray:
-    """Integral over each span between consecutive ``edges_s`` of a sum of boxcar rates.
-
-    Rate ``rates[i]`` (any unit per second) runs from ``starts_s[i]`` to ``ends_s[i]``;
-    overlapping boxcars add. One sort and one interpolation, no loop over intervals.
+    Boxcar ``i`` runs at ``rates[i]`` (1 if None) from ``starts_s[i]`` to ``ends_s[i]``; a step
+    it covers in part gets the covered share. Where boxcars overlap, ``overlap="max"`` keeps
+    the larger (a door open twice is open once), ``"add"`` sums them. One slice per boxcar,
+    so the cost grows with the number of boxcars, not of steps.
 
     Returns
     -------
     numpy.ndarray
-        ``edges_s.size − 1`` values, in the rate's unit times seconds.
+        ``n_steps`` values, in the rate's unit.
     """
-    start = np.asarray(starts_s, dtype=float)
-    if start.size == 0:
-        return np.zeros(max(edges_s.size - 1, 0))
-    rate = np.asarray(rates, dtype=float)
-    events = np.concatenate((start, np.asarray(ends_s, dtype=float)))
-    deltas = np.concatenate((rate, -rate))
-    order = np.argsort(events, kind="stable")
-    events, running = events[order], np.cumsum(deltas[order])
-    integral = np.concatenate(([0.0], np.cumsum(np.diff(events) * running[:-1])))
-    return np.diff(np.interp(edges_s, events, integral))
+    out = np.zeros(n_steps)
+    start = np.asarray(starts_s, dtype=float) / dt_s
+    end = np.asarray(ends_s, dtype=float) / dt_s
+    rate = np.ones(start.size) if rates is None else np.asarray(rates, dtype=float)
+    for a, b, r in zip(start.tolist(), end.tolist(), rate.tolist(), strict=True):
+        first, last = max(math.floor(a), 0), min(math.ceil(b), n_steps)
+        if b <= a or first >= last:
+            continue
+        cover = np.full(last - first, r)
+        cover[0] = r * (min(b, first + 1) - max(a, first))
+        if last - first > 1:
+            cover[-1] = r * (min(b, last) - max(a, last - 1))
+        span = out[first:last]
+        if overlap == "add":
+            span += cover
+        else:
+            np.maximum(span, cover, out=span)
+    return out
+
+
+def uniform_interp(values: ArrayLike, per_interval: int, n: int) -> FloatArray:
+    """Linear interpolation of values on a uniform coarse grid to ``n`` points spaced
+    ``1/per_interval`` of its step, the first on the first value (no search: the points fall
+    at known positions)."""
+    coarse = np.asarray(values, dtype=float)
+    if coarse.size == 1:
+        return np.full(n, coarse[0])
+    fraction = np.arange(per_interval) / per_interval
+    filled = (coarse[:-1, None] + np.diff(coarse)[:, None] * fraction[None, :]).ravel()
+    if filled.size >= n:
+        return filled[:n]
+    return np.concatenate((filled, np.full(n - filled.size, coarse[-1])))

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core.arrays import FloatArray, interval_fraction, rate_integral
+from core.arrays import FloatArray, interval_rates
 from core.params import VehicleParams
 
 #: Paper Table 2: ambient temperature [°C] and the electric power [W] that keeps the cab at
@@ -66,24 +66,29 @@ def cab_deficit_j(
     initial_j
         Deficit already there when the van parks [J] (a recovery not finished yet).
     """
-    ambient = np.asarray(ambient_c, dtype=float)
-    gap_k = np.abs(CAB_SETPOINT_C - ambient)
-    power = cabin_hvac_power_w(vehicle, ambient)
+    settled_j, rate = _drift(vehicle, np.asarray(ambient_c, dtype=float))
+    keep = np.exp(-rate * np.asarray(parked_s, dtype=float))
+    return settled_j + (np.asarray(initial_j, dtype=float) - settled_j) * keep
+
+
+def _drift(vehicle: VehicleParams, ambient_c: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Deficit a parked cab settles at [J] and its rate of approach [1/s]
+    (:func:`cab_deficit_j`)."""
+    gap_k = np.abs(CAB_SETPOINT_C - ambient_c)
+    power = cabin_hvac_power_w(vehicle, ambient_c)
     capacity = vehicle.cab_recovery_energy_j_k
     safe_gap = np.where(gap_k > 0.1, gap_k, 1.0)
     rate = np.where(gap_k > 0.1, power / safe_gap / capacity, 0.0)
-    settled_j = capacity * (1.0 - parked_share(vehicle)) * gap_k * (power > 0)
-    keep = np.exp(-rate * np.asarray(parked_s, dtype=float))
-    return settled_j + (np.asarray(initial_j, dtype=float) - settled_j) * keep
+    return capacity * (1.0 - parked_share(vehicle)) * gap_k * (power > 0), rate
 
 
 def cab_power_w(
     vehicle: VehicleParams,
     ambient_c: FloatArray,
-    step_end_s: FloatArray,
     dt_s: float,
     parked: Sequence[tuple[float, float]] = (),
     initial_deficit_j: float = 0.0,
+    hvac_w: FloatArray | None = None,
 ) -> FloatArray:
     """Electric power of the cab HVAC over each step [W] (Table 2 and the thermal duty).
 
@@ -97,15 +102,15 @@ def cab_power_w(
     Parameters
     ----------
     ambient_c
-        Outside temperature of each step [°C].
-    step_end_s
-        End time of each step [s].
+        Outside temperature of each step [°C]; step ``k`` spans ``[k·dt, (k+1)·dt)``.
     parked
         ``(start_s, duration_s)`` of each stop, in time order.
     initial_deficit_j
         Energy to bring the cab to 20 °C at the start [J].
+    hvac_w
+        The Table 2 power of each step [W] when already known (:func:`cabin_hvac_power_w`).
     """
-    base = cabin_hvac_power_w(vehicle, ambient_c)
+    base = cabin_hvac_power_w(vehicle, ambient_c) if hvac_w is None else hvac_w
     share = parked_share(vehicle)
     nothing_parked = not parked or share == 1.0
     if (
@@ -114,31 +119,33 @@ def cab_power_w(
         or (nothing_parked and initial_deficit_j == 0)
     ):
         return base
+    n = base.size
     # At full power while parked the HVAC holds the cab as it does on the road: no stops count.
     stops = [] if share == 1.0 else parked
     starts = np.array([p[0] for p in stops], dtype=float)
     durations = np.array([p[1] for p in stops], dtype=float)
-    power = base * (1.0 - (1.0 - share) * interval_fraction(starts, durations, step_end_s, dt_s))
     ends = starts + durations
-    at_end = np.clip(np.searchsorted(step_end_s, ends), 0, base.size - 1)
+    power = base * (1.0 - (1.0 - share) * interval_rates(starts, ends, n, dt_s))
+    at_end = np.clip((ends / dt_s).astype(int), 0, n - 1)
     spare = np.maximum(
         vehicle.cab_hvac_max_power_w - base[at_end], 0.1 * vehicle.cab_hvac_max_power_w
     )
+    settled, rate = _drift(vehicle, ambient_c[at_end])
+    keep = np.exp(-rate * durations)
     boost_start, boost_end, boost_rate = [], [], []
     deficit_j = initial_deficit_j
-    clock_s = float(step_end_s[0] - dt_s)
+    clock_s = 0.0
     rate_w = max(vehicle.cab_hvac_max_power_w - float(base[0]), 0.1 * vehicle.cab_hvac_max_power_w)
-    for start_s, duration_s, end_s, ambient, spare_w in zip(
-        starts, durations, ends, ambient_c[at_end], spare, strict=True
+    for start_s, end_s, settled_j, kept, spare_w in zip(
+        starts.tolist(), ends.tolist(), settled.tolist(), keep.tolist(), spare.tolist(), strict=True
     ):
         delivered_j = min(deficit_j, max(start_s - clock_s, 0.0) * rate_w)
         boost_start.append(clock_s)
         boost_end.append(clock_s + delivered_j / rate_w)
         boost_rate.append(rate_w)
-        deficit_j = float(cab_deficit_j(vehicle, ambient, duration_s, deficit_j - delivered_j))
-        clock_s, rate_w = float(end_s), float(spare_w)
+        deficit_j = settled_j + (deficit_j - delivered_j - settled_j) * kept
+        clock_s, rate_w = end_s, spare_w
     boost_start.append(clock_s)
     boost_end.append(clock_s + deficit_j / rate_w)
     boost_rate.append(rate_w)
-    edges = np.concatenate(([step_end_s[0] - dt_s], step_end_s))
-    return power + rate_integral(boost_start, boost_end, boost_rate, edges) / dt_s
+    return power + interval_rates(boost_start, boost_end, n, dt_s, boost_rate, overlap="add")

@@ -273,52 +273,66 @@ def _integrate_box(
     start_c: float,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Box temperature at the end of each step [°C] and the heat removed and added in each
-    step [W], with the exact exponential solution over blocks of :data:`BOX_STEP_S`."""
+    step [W], with the exact exponential solution over blocks of :data:`BOX_STEP_S`.
+
+    While the box sits at its set-point and the unit can match the load, the block is settled
+    in one vectorised pass; the Python loop runs only through excursions (an open door beyond
+    the unit's capacity, a warm start, a cold drift without heater).
+    """
     n = ambient_c.size
     per_block = max(round(BOX_STEP_S / dt_s), 1)
     edges = np.arange(0, n, per_block)
     counts = np.diff(np.append(edges, n))
 
-    def block_mean(values: FloatArray) -> list[float]:
-        return (np.add.reduceat(values, edges) / counts).tolist() if n else []
+    def block_mean(values: FloatArray) -> FloatArray:
+        return np.add.reduceat(values, edges) / counts if n else np.zeros(0)
 
     wall_g = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
-    ambient = block_mean(ambient_c)
-    solar = block_mean(solar_heat)
-    door_g = block_mean(door_conductance)
+    conductance = wall_g + block_mean(door_conductance)
+    equilibrium = block_mean(ambient_c) + block_mean(solar_heat) / conductance
     capacity = block_mean(capacity_j_k)
-    seconds = (counts * dt_s).tolist()
+    seconds = counts * dt_s
     setpoint = box.setpoint_c
     cool_w = box.refrigeration_capacity_w
     heat_w = box.heating_capacity_w if box.heater_enabled else 0.0
-    ends, removed, added = [], [], []
+    # At the set-point the unit must remove (or add) exactly the load.
+    load_w = conductance * (equilibrium - setpoint)
+    holds = (load_w <= cool_w) & (load_w >= -heat_w)
+    ends = np.full(edges.size, setpoint)
+    removed = np.maximum(load_w, 0.0)
+    added = np.maximum(-load_w, 0.0)
+    breaks = np.flatnonzero(~holds)
+    g_list, eq_list, c_list, h_list = (
+        x.tolist() for x in (conductance, equilibrium, capacity, seconds)
+    )
     t = start_c
-    for amb, sun, g_door, c, h in zip(ambient, solar, door_g, capacity, seconds, strict=True):
-        g = wall_g + g_door
-        equilibrium = amb + sun / g
+    i = 0
+    while i < edges.size:
+        if t == setpoint and holds[i]:
+            i = (
+                int(breaks[np.searchsorted(breaks, i)])
+                if breaks.size and breaks[-1] >= i
+                else edges.size
+            )
+            continue
+        g, eq, c, h = g_list[i], eq_list[i], c_list[i], h_list[i]
         decay = math.exp(-g * h / c)
-        free = equilibrium + (t - equilibrium) * decay
+        free = eq + (t - eq) * decay
         reach = (1.0 - decay) / g
         cool_j = heat_j = 0.0
         if free > setpoint:
             end = max(free - cool_w * reach, setpoint)
-            cool_j = g * h * (equilibrium - 0.5 * (t + end)) - c * (end - t)
-            cool_j = min(max(cool_j, 0.0), cool_w * h)
+            cool_j = min(max(g * h * (eq - 0.5 * (t + end)) - c * (end - t), 0.0), cool_w * h)
         elif free < setpoint and heat_w > 0:
             end = min(free + heat_w * reach, setpoint)
-            heat_j = c * (end - t) - g * h * (equilibrium - 0.5 * (t + end))
-            heat_j = min(max(heat_j, 0.0), heat_w * h)
+            heat_j = min(max(c * (end - t) - g * h * (eq - 0.5 * (t + end)), 0.0), heat_w * h)
         else:
             end = free
-        ends.append(end)
-        removed.append(cool_j / h)
-        added.append(heat_j / h)
+        ends[i], removed[i], added[i] = end, cool_j / h, heat_j / h
         t = end
-    block_end = np.array(ends)
-    block_start = np.concatenate(([start_c], block_end[:-1]))
+        i += 1
+    block_start = np.concatenate(([start_c], ends[:-1]))
     # Within a block, the temperature moves linearly from its start to its end.
     position = (np.arange(n) - np.repeat(edges, counts) + 1) / np.repeat(counts, counts)
-    temperature = np.repeat(block_start, counts) + position * np.repeat(
-        block_end - block_start, counts
-    )
+    temperature = np.repeat(block_start, counts) + position * np.repeat(ends - block_start, counts)
     return temperature, np.repeat(removed, counts), np.repeat(added, counts)

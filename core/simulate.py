@@ -8,6 +8,7 @@ samples has ``n − 1`` steps; per-step arrays hold the mean power over each ste
 from __future__ import annotations
 
 import datetime as dt
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -15,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from core import battery as battery_model
-from core.arrays import FloatArray, interval_fraction
+from core.arrays import FloatArray, interval_rates, uniform_interp
 from core.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
 from core.cargo import BoxResult, precondition_energy_j, refrigeration
 from core.clock import SECONDS_PER_DAY, check_representable, local_clock
@@ -95,11 +96,19 @@ class SimulationResult:
     weather_source: WeatherSource
 
 
-def _per_step(value: ArrayLike, n_samples: int, name: str, low: float, high: float) -> FloatArray:
-    """A scalar or per-sample input as per-step values (mean of each step's two samples)."""
+def _per_step(
+    value: ArrayLike, n_samples: int, name: str, low: float, high: float
+) -> FloatArray | float:
+    """A per-sample input as per-step values (mean of each step's two samples); a scalar stays
+    a scalar."""
     array = np.asarray(value, dtype=float)
     if array.ndim == 0:
-        array = np.full(n_samples, float(array))
+        scalar = float(array)
+        if not (math.isfinite(scalar) and low <= scalar <= high):
+            raise InvalidParameterError(
+                f"{name} = {scalar} is outside {low}..{high} or not finite", f"{name}[0]"
+            )
+        return scalar
     if array.shape != (n_samples,):
         raise InvalidParameterError(
             f"{name} must be a number or hold one value per speed sample ({n_samples}), "
@@ -218,7 +227,7 @@ def simulate(
 
     time_s = np.arange(n) * dt_s
     step_end = time_s[1:]
-    outside = _environment(start, location, van, weather, step_end - 0.5 * dt_s)
+    outside = _environment(start, location, van, weather, n - 1, dt_s)
     ambient = outside.ambient_c
     box_params = van.cargo_box
     box = refrigeration(
@@ -226,7 +235,7 @@ def simulate(
         ambient,
         outside.solar_heat_w,
         door_open_fraction(door_openings, step_end, dt_s),
-        payload_step,
+        np.broadcast_to(payload_step, ambient.shape),
         dt_s,
         initial_c=None if van.precondition_at_depot else float(ambient[0]),
     )
@@ -253,10 +262,10 @@ def simulate(
         "cabin": cab_power_w(
             vehicle,
             ambient,
-            step_end,
             dt_s,
             [(p.start_s, p.duration_s) for p in parked],
             0.0 if van.precondition_at_depot else cab_gap_j,
+            outside.cab_hvac_w,
         ),
         "refrigeration": box.power_w,
     }
@@ -298,8 +307,11 @@ def door_open_fraction(
     openings: Sequence[DoorOpening], step_end_s: FloatArray, dt_s: float
 ) -> FloatArray:
     """Share of each step [–] during which the door is open (overlaps count once)."""
-    return interval_fraction(
-        [o.start_s for o in openings], [o.duration_s for o in openings], step_end_s, dt_s
+    return interval_rates(
+        [o.start_s for o in openings],
+        [o.start_s + o.duration_s for o in openings],
+        step_end_s.size,
+        dt_s,
     )
 
 
@@ -311,10 +323,11 @@ ENVIRONMENT_STEP_S = 60.0
 
 @dataclass(frozen=True)
 class _Environment:
-    """Outside conditions of every step."""
+    """Outside conditions of every step, and the cab's Table 2 power that follows from them."""
 
     ambient_c: FloatArray
     solar_heat_w: FloatArray
+    cab_hvac_w: FloatArray
     wind_from_east_mps: FloatArray
     wind_from_north_mps: FloatArray
     calm: bool
@@ -327,23 +340,31 @@ def _environment(
     location: Location,
     van: VanParams,
     weather: Forecast | None,
-    mid_s: FloatArray,
+    n_steps: int,
+    dt_s: float,
 ) -> _Environment:
-    """Temperature, absorbed sun and wind at each step's middle ``mid_s`` [s after start],
-    computed every :data:`ENVIRONMENT_STEP_S` and interpolated linearly."""
-    coarse_s = np.append(np.arange(mid_s[0], mid_s[-1], ENVIRONMENT_STEP_S), mid_s[-1])
+    """Temperature, absorbed sun, cab power and wind at the middle of each of ``n_steps``
+    steps, computed every :data:`ENVIRONMENT_STEP_S` (on the last moment at most) and
+    interpolated linearly."""
+    per_interval = max(round(ENVIRONMENT_STEP_S / dt_s), 1)
+    first_s, last_s = 0.5 * dt_s, (n_steps - 0.5) * dt_s
+    coarse_s = np.minimum(
+        first_s + per_interval * dt_s * np.arange(math.ceil((n_steps - 1) / per_interval) + 1),
+        last_s,
+    )
     clock = local_clock(start, coarse_s)
     outside = conditions(weather, clock, location.lat)
     sin_h, month = sun(clock.utc_s, location)
 
     def fine(values: FloatArray) -> FloatArray:
-        return np.interp(mid_s, coarse_s, values)
+        return uniform_interp(values, per_interval, n_steps)
 
     calm = not (np.any(outside.wind_from_east_mps) or np.any(outside.wind_from_north_mps))
     still = np.zeros(0)
     return _Environment(
         ambient_c=fine(outside.ambient_c),
         solar_heat_w=fine(_solar_heat_w(van, outside, sin_h, month)),
+        cab_hvac_w=fine(cabin_hvac_power_w(van.vehicle, outside.ambient_c)),
         wind_from_east_mps=still if calm else fine(outside.wind_from_east_mps),
         wind_from_north_mps=still if calm else fine(outside.wind_from_north_mps),
         calm=calm,

@@ -255,8 +255,19 @@ def headwind_mps(
     ``w·cos(θ_wind_from − θ_heading) = E·sin θ_h + N·cos θ_h`` with the wind's "from" vector
     (E, N); zero where the heading is unknown (NaN).
     """
-    heading = np.radians(heading_deg)
-    head = wind_from_east_mps * np.sin(heading) + wind_from_north_mps * np.cos(heading)
+    heading = np.asarray(heading_deg, dtype=float)
+    # A road's heading changes segment by segment: take the trigonometry once per run.
+    if heading.size:
+        before, after = heading[:-1], heading[1:]
+        same = (after == before) | (np.isnan(after) & np.isnan(before))
+        changes = np.flatnonzero(~same) + 1
+        runs = np.concatenate(([0], changes))
+        lengths = np.diff(np.append(runs, heading.size))
+        radians = np.radians(heading[runs])
+        east, north = np.repeat(np.sin(radians), lengths), np.repeat(np.cos(radians), lengths)
+    else:
+        east = north = heading
+    head = wind_from_east_mps * east + wind_from_north_mps * north
     return np.where(np.isfinite(head), head, 0.0)
 
 

@@ -37,8 +37,7 @@ def test_auxiliaries_are_the_papers_constant():
 
 def _cab(mode, ambient_c=-10.0, parked=((600.0, 600.0),), n=3600, deficit_j=0.0, **fields):
     vehicle = VehicleParams(cab_hvac_at_stops=mode, **fields)
-    step_end = np.arange(1, n + 1, dtype=float)
-    return cab_power_w(vehicle, np.full(n, ambient_c), step_end, 1.0, list(parked), deficit_j)
+    return cab_power_w(vehicle, np.full(n, ambient_c), 1.0, list(parked), deficit_j)
 
 
 # At −10 °C Table 2 gives 3200 W for a 30 K difference: G = 106.7 W/K. With the default
