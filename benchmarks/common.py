@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import socket
 import subprocess
@@ -10,6 +11,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import httpx
 import numpy as np
@@ -50,6 +52,26 @@ def euc_2d_matrix(path: Path) -> np.ndarray:
     xy = np.array(points)
     distance = np.sqrt(((xy[:, None, :] - xy[None, :, :]) ** 2).sum(axis=-1))
     return np.floor(distance + 0.5).astype(np.int64)
+
+
+def _burn(stop: Any) -> None:
+    while not stop.is_set():
+        sum(i * i for i in range(10_000))
+
+
+@contextmanager
+def busy_core() -> Iterator[None]:
+    """Another process keeps one core fully busy for the duration (a second client's solve)."""
+    context = multiprocessing.get_context("spawn")
+    stop = context.Event()
+    burner = context.Process(target=_burn, args=(stop,), daemon=True)
+    burner.start()
+    time.sleep(0.3)
+    try:
+        yield
+    finally:
+        stop.set()
+        burner.join(timeout=5)
 
 
 @contextmanager

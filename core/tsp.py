@@ -1,12 +1,24 @@
 """The round trip: one van, start and end at the depot (paper §4), with OR-Tools.
 
-Everyday rounds are solved exactly with CP-SAT's circuit constraint and its LP relaxation
-(linearization level 2, which proves 20-node rounds in about 10 ms and 50–75-node rounds within
-a second on this machine; benchmarks/). From 30 nodes on, the OR-Tools routing library first
-spends a quarter of the budget on a good tour — a Christofides start, then guided local search
-with the multi-armed-bandit operator schedule and only the operators that apply to one route —
-and hands it to CP-SAT as a hint. Above ``EXACT_MAX_NODES`` routing alone uses the budget.
-Costs are non-negative integers: the caller rounds explicitly (metres, seconds, Wh).
+Three tools, each where it is strongest (measured on TSPLIB and random instances,
+``benchmarks/bench_planner.py``):
+
+1. CP-SAT's circuit constraint with its LP relaxation (linearization level 2) and the 2-cycle
+   cuts ``x_ij + x_ji ≤ 1``, which the circuit's LP lacks and which make it much tighter. Up to
+   :data:`FULL_GRAPH_MAX_NODES` places it runs on every arc and proves the optimum in tens of
+   milliseconds.
+2. Beyond that, the same model on each place's :data:`NEIGHBOURS` nearest successors and
+   predecessors (plus the arcs of the start tour): a tenth of the arcs, so the LP and the
+   search are several times faster. Its optimum is optimal over those arcs — in every TSPLIB
+   and random instance checked it is the true optimum — but it is not a proof over all arcs,
+   so the status is ``feasible``.
+3. When CP-SAT neither proves nor finishes, the OR-Tools routing library's guided local search
+   improves its best tour for the rest of the budget (operators that apply to one route only).
+   Above :data:`EXACT_MAX_NODES` it has the whole budget.
+
+Every search is single-threaded and deterministic, so a busy second core does not change the
+answer, and the time limit is a deadline: nothing runs past it. Costs are non-negative
+integers: the caller rounds explicitly (metres, seconds, Wh).
 """
 
 from __future__ import annotations
@@ -24,12 +36,14 @@ from ortools.sat.python import cp_model
 from core.exceptions import InvalidParameterError
 
 SolverStatus = Literal["optimal", "feasible", "fixed_order"]
-#: Rounds up to this many nodes (depot included) go to CP-SAT, which can prove optimality.
+#: Rounds up to this many nodes (depot included) are solved on the full graph (a proof).
+FULL_GRAPH_MAX_NODES = 30
+#: Rounds up to this many nodes go to CP-SAT; larger ones to routing alone.
 EXACT_MAX_NODES = 150
-#: From this many nodes on, routing first finds a hint for CP-SAT...
-HINT_MIN_NODES = 30
-#: ...with this share of the time limit.
-HINT_TIME_SHARE = 0.25
+#: Nearest successors and predecessors of each node kept in the sparse CP-SAT model.
+NEIGHBOURS = 7
+#: Share of the budget CP-SAT has before guided local search takes over its best tour.
+EXACT_TIME_SHARE = 0.7
 
 
 @dataclass(frozen=True)
@@ -41,7 +55,7 @@ class Tour:
     order
         Node indices, starting and ending at the depot 0.
     status
-        ``optimal`` (proven), ``feasible`` (time limit or heuristic stop) or ``fixed_order``.
+        ``optimal`` (proven over all arcs), ``feasible`` (the best found) or ``fixed_order``.
     cost
         Sum of the integer arc costs along the tour.
     runtime_s
@@ -77,7 +91,7 @@ def solve_tour(
     -------
     Tour
         Deterministic for the same input when the search ends before the time limit (always
-        for exact solves; routing stops at a fixed number of solutions).
+        when CP-SAT finishes; the guided local search stops only at its time limit).
     """
     cost = np.asarray(cost, dtype=np.int64)
     n = cost.shape[0]
@@ -86,76 +100,98 @@ def solve_tour(
     if not time_limit_s > 0:
         raise InvalidParameterError(f"time_limit_s must be > 0, got {time_limit_s}", "time_limit_s")
     started = time.perf_counter()
-    if keep_order or n <= 2:
-        order = [*range(n), 0]
-        status: SolverStatus = "fixed_order" if keep_order else "optimal"
+    deadline = started + time_limit_s
+
+    def done(order: list[int], status: SolverStatus) -> Tour:
         return Tour(order, status, tour_cost(cost, order), time.perf_counter() - started)
+
+    if keep_order or n <= 3:
+        order = [*range(n), 0]
+        if n == 3 and not keep_order:
+            order = min(([0, 1, 2, 0], [0, 2, 1, 0]), key=lambda o: tour_cost(cost, o))
+        return done(order, "fixed_order" if keep_order else "optimal")
+    start = _first_tour(cost)
     if n > EXACT_MAX_NODES:
-        order = _solve_routing(cost, started + time_limit_s)
-        return Tour(order, "feasible", tour_cost(cost, order), time.perf_counter() - started)
-    hint = (
-        _solve_routing(cost, started + time_limit_s * HINT_TIME_SHARE)
-        if n >= HINT_MIN_NODES
-        else None
+        return done(_improve(cost, start, deadline), "feasible")
+    full = n <= FULL_GRAPH_MAX_NODES
+    exact_deadline = deadline if full else started + time_limit_s * EXACT_TIME_SHARE
+    found, proven = _solve_exact(cost, start, exact_deadline, None if full else NEIGHBOURS)
+    best = (
+        found if found is not None and tour_cost(cost, found) <= tour_cost(cost, start) else start
     )
-    exact = _solve_exact(cost, started + time_limit_s, hint)
-    candidates = [t for t in (exact, hint) if t is not None]
-    if not candidates:  # neither finished in time: the visiting order as given
-        candidates = [[*range(n), 0]]
-    if exact is not None and exact.status == "optimal":
-        best, status = exact.order, "optimal"
-    else:
-        best = min(
-            (c.order if isinstance(c, Tour) else c for c in candidates),
-            key=lambda order: tour_cost(cost, order),
-        )
-        status = "feasible"
-    return Tour(best, status, tour_cost(cost, best), time.perf_counter() - started)
+    if proven:
+        return done(best, "optimal" if full else "feasible")
+    if time.perf_counter() < deadline - _ROUTING_STOP_MARGIN_S:
+        best = _improve(cost, best, deadline)
+    return done(best, "feasible")
 
 
 #: Time kept back from CP-SAT's budget for its own stopping and for reading the solution, a
-#: fixed part and a part per arc [s] (measured: about 45 ms at 150 nodes).
+#: fixed part and a part per arc [s].
 _EXACT_STOP_MARGIN_S = 0.010
 _EXACT_STOP_MARGIN_PER_ARC_S = 2.5e-6
 
 
-def _solve_exact(
-    cost: NDArray[np.int64], deadline: float, hint: list[int] | None = None
-) -> Tour | None:
-    """CP-SAT with a circuit constraint and its LP relaxation, to finish by ``deadline``
-    (a ``time.perf_counter`` value); one worker, so the search is deterministic. ``hint`` is a
-    tour to start from."""
+def _arcs(cost: NDArray[np.int64], start: list[int], neighbours: int | None) -> NDArray[np.bool_]:
+    """Which arcs the CP-SAT model has: all, or each node's nearest successors and
+    predecessors plus the start tour's arcs."""
     n = cost.shape[0]
+    if neighbours is None or neighbours >= n - 1:
+        keep = np.ones((n, n), dtype=bool)
+    else:
+        ranked = cost.astype(float)
+        np.fill_diagonal(ranked, np.inf)
+        keep = np.zeros((n, n), dtype=bool)
+        rows = np.arange(n)
+        keep[rows[:, None], np.argsort(ranked, axis=1)[:, :neighbours]] = True
+        keep[np.argsort(ranked, axis=0)[:neighbours, :], rows[None, :]] = True
+        keep[start[:-1], start[1:]] = True
+    np.fill_diagonal(keep, False)
+    return keep
+
+
+def _solve_exact(
+    cost: NDArray[np.int64], start: list[int], deadline: float, neighbours: int | None
+) -> tuple[list[int] | None, bool]:
+    """CP-SAT with a circuit constraint, its LP relaxation and 2-cycle cuts, from ``start``,
+    to finish by ``deadline`` (a ``time.perf_counter`` value); one worker, so the search is
+    deterministic. The best tour found (or None) and whether it is proven optimal over the
+    model's arcs."""
+    n = cost.shape[0]
+    keep = _arcs(cost, start, neighbours)
     model = cp_model.CpModel()
-    arcs = {(i, j): model.new_bool_var(f"x{i}_{j}") for i in range(n) for j in range(n) if i != j}
+    arcs = {
+        (int(i), int(j)): model.new_bool_var("") for i, j in zip(*np.nonzero(keep), strict=True)
+    }
     model.add_circuit([(i, j, var) for (i, j), var in arcs.items()])
     model.minimize(sum(int(cost[i, j]) * var for (i, j), var in arcs.items()))
-    if hint is not None:
-        used = set(itertools.pairwise(hint))
-        for arc, var in arcs.items():
-            model.add_hint(var, arc in used)
+    for (i, j), var in arcs.items():
+        back = arcs.get((j, i))
+        if i < j and back is not None:
+            model.add_bool_or([var.Not(), back.Not()])
+    used = set(itertools.pairwise(start))
+    for arc, var in arcs.items():
+        model.add_hint(var, arc in used)
     solver = cp_model.CpSolver()
     # The LP relaxation of the circuit (level 2) is what proves TSP optimality fast; presolve
     # only costs time on this model.
     solver.parameters.linearization_level = 2
     solver.parameters.cp_model_presolve = False
-    # The budget is what is left once the model is built.
     margin_s = _EXACT_STOP_MARGIN_S + _EXACT_STOP_MARGIN_PER_ARC_S * len(arcs)
     budget_s = deadline - time.perf_counter() - margin_s
     if budget_s <= 0:
-        return None
+        return None, False
     solver.parameters.max_time_in_seconds = budget_s
     solver.parameters.num_workers = 1
     solver.parameters.random_seed = 0
     result = solver.solve(model)
     if result not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
-        return None
+        return None, False
     successor = {i: j for (i, j), var in arcs.items() if solver.boolean_value(var)}
     order = [0]
     while len(order) <= n:
         order.append(successor[order[-1]])
-    status: SolverStatus = "optimal" if result == cp_model.OPTIMAL else "feasible"
-    return Tour(order, status, tour_cost(cost, order), solver.wall_time)
+    return order, result == cp_model.OPTIMAL
 
 
 # Routing operators that only act on optional visits, pickup-delivery pairs or several routes:
@@ -177,22 +213,45 @@ _IDLE_OPERATORS = (
     "use_local_cheapest_insertion_visit_types_lns",
 )
 _BOOL_FALSE = 2  # ortools.util.optional_boolean_pb2.BOOL_FALSE
-
-
 #: Time kept back from the routing search for stopping and reading the tour [s].
 _ROUTING_STOP_MARGIN_S = 0.010
 
 
-def _solve_routing(cost: NDArray[np.int64], deadline: float) -> list[int]:
-    """OR-Tools routing: Christofides start, guided local search, done by ``deadline`` (a
-    ``time.perf_counter`` value; at least the first solution is always built)."""
+def _routing(cost: NDArray[np.int64]) -> tuple[pywrapcp.RoutingIndexManager, pywrapcp.RoutingModel]:
     n = cost.shape[0]
     manager = pywrapcp.RoutingIndexManager(n, 1, 0)
     routing = pywrapcp.RoutingModel(manager)
     transit = routing.RegisterTransitMatrix(cost.tolist())
     routing.SetArcCostEvaluatorOfAllVehicles(transit)
+    return manager, routing
+
+
+def _read(
+    manager: pywrapcp.RoutingIndexManager, routing: pywrapcp.RoutingModel, solution: object
+) -> list[int]:
+    index = routing.Start(0)
+    order = []
+    while not routing.IsEnd(index):
+        order.append(manager.IndexToNode(index))
+        index = solution.Value(routing.NextVar(index))  # type: ignore[attr-defined]
+    return [*order, 0]
+
+
+def _first_tour(cost: NDArray[np.int64]) -> list[int]:
+    """Christofides' tour (the routing library's first-solution strategy, without its local
+    search): milliseconds even for hundreds of places."""
+    manager, routing = _routing(cost)
     params = pywrapcp.DefaultRoutingSearchParameters()
     params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.CHRISTOFIDES
+    params.solution_limit = 1
+    return _read(manager, routing, routing.SolveWithParameters(params))
+
+
+def _improve(cost: NDArray[np.int64], start: list[int], deadline: float) -> list[int]:
+    """Guided local search from ``start`` until ``deadline`` (a ``time.perf_counter`` value),
+    with the multi-armed-bandit operator schedule; the better of start and result."""
+    manager, routing = _routing(cost)
+    params = pywrapcp.DefaultRoutingSearchParameters()
     params.use_multi_armed_bandit_concatenate_operators = True
     for operator in _IDLE_OPERATORS:
         setattr(params.local_search_operators, operator, _BOOL_FALSE)
@@ -201,10 +260,10 @@ def _solve_routing(cost: NDArray[np.int64], deadline: float) -> list[int]:
     )
     budget_s = deadline - time.perf_counter() - _ROUTING_STOP_MARGIN_S
     params.time_limit.FromMilliseconds(max(int(budget_s * 1000), 1))
-    solution = routing.SolveWithParameters(params)
-    index = routing.Start(0)
-    order = []
-    while not routing.IsEnd(index):
-        order.append(manager.IndexToNode(index))
-        index = solution.Value(routing.NextVar(index))
-    return [*order, 0]
+    routing.CloseModelWithParameters(params)
+    initial = routing.ReadAssignmentFromRoutes([start[1:-1]], True)
+    solution = routing.SolveFromAssignmentWithParameters(initial, params)
+    if solution is None:
+        return start
+    improved = _read(manager, routing, solution)
+    return min((improved, start), key=lambda order: tour_cost(cost, order))
