@@ -8,7 +8,7 @@ OSRM := .router/osrm/bin/osrm-routed
 PBF ?=
 ROUTER_DIR ?= .router/region
 
-.PHONY: test bench serve openapi report lint clean router router-serve
+.PHONY: test bench serve worker openapi report lint clean router router-serve
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -40,7 +40,11 @@ router-serve: $(OSRM)
 	$(BIN)/python -m tools.osrm serve $(ROUTER_DIR) --port $${OSRM_PORT:-5000}
 
 serve: $(STAMP)
-	$(BIN)/uvicorn app.main:app --host $${COLDROUTE_HOST:-0.0.0.0} --port $${COLDROUTE_PORT:-8000}
+	$(BIN)/python -m app.serve
+
+# A Celery worker for the jobs (needs COLDROUTE_BROKER_URL and a PostgreSQL COLDROUTE_DATABASE_URL).
+worker: $(STAMP)
+	$(BIN)/celery -A app.jobs.worker worker --pool=threads --loglevel=INFO --concurrency=$${COLDROUTE_WORKERS:-$$(nproc)}
 
 openapi: $(STAMP)
 	$(BIN)/python -m app.openapi > openapi/openapi.json

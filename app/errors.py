@@ -11,10 +11,18 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
+from app.execution import UnavailableError
 from core.exceptions import CoreError, LimitExceededError, ServiceUnavailableError
 
 PROBLEM_JSON = "application/problem+json"
 _log = logging.getLogger("coldroute")
+
+
+def problem_body(status: int, title: str, detail: str, **extra: Any) -> dict[str, Any]:
+    """An RFC 9457 problem document; ``type`` names the problem kind under /problems/."""
+    slug = title.lower().replace(" ", "-")
+    body = {"type": f"/problems/{slug}", "title": title, "status": status, "detail": detail}
+    return body | extra
 
 
 def problem(
@@ -24,10 +32,25 @@ def problem(
     headers: Mapping[str, str] | None = None,
     **extra: Any,
 ) -> JSONResponse:
-    """A problem response; ``type`` names the problem kind under /problems/."""
-    slug = title.lower().replace(" ", "-")
-    body = {"type": f"/problems/{slug}", "title": title, "status": status, "detail": detail}
-    return JSONResponse(body | extra, status_code=status, media_type=PROBLEM_JSON, headers=headers)
+    """A problem response (:func:`problem_body`)."""
+    return JSONResponse(
+        problem_body(status, title, detail, **extra),
+        status_code=status,
+        media_type=PROBLEM_JSON,
+        headers=headers,
+    )
+
+
+def core_problem(error: CoreError) -> dict[str, Any]:
+    """The 422 problem of a core error, naming its field."""
+    title = "Limit exceeded" if isinstance(error, LimitExceededError) else "Invalid request"
+    errors = [{"field": error.field or "body", "message": error.message, "type": "value_error"}]
+    return problem_body(422, title, error.message, errors=errors)
+
+
+def service_problem(error: ServiceUnavailableError) -> dict[str, Any]:
+    """The 503 problem of an outside service that failed, naming it."""
+    return problem_body(503, "Service unavailable", error.message, service=error.service)
 
 
 def _location(loc: tuple[Any, ...]) -> str:
@@ -50,9 +73,7 @@ async def _validation(_: Request, error: Exception) -> JSONResponse:
 
 async def _core(_: Request, error: Exception) -> JSONResponse:
     assert isinstance(error, CoreError)
-    title = "Limit exceeded" if isinstance(error, LimitExceededError) else "Invalid request"
-    errors = [{"field": error.field or "body", "message": error.message, "type": "value_error"}]
-    return problem(422, title, error.message, errors=errors)
+    return JSONResponse(core_problem(error), status_code=422, media_type=PROBLEM_JSON)
 
 
 async def _http(_: Request, error: Exception) -> JSONResponse:
@@ -73,12 +94,22 @@ SERVICE_RETRY_AFTER_S = 30
 
 async def _service(_: Request, error: Exception) -> JSONResponse:
     assert isinstance(error, ServiceUnavailableError)
+    return JSONResponse(
+        service_problem(error),
+        status_code=503,
+        media_type=PROBLEM_JSON,
+        headers={"Retry-After": str(SERVICE_RETRY_AFTER_S)},
+    )
+
+
+async def _unavailable(_: Request, error: Exception) -> JSONResponse:
+    assert isinstance(error, UnavailableError)
     return problem(
         503,
         "Service unavailable",
-        error.message,
-        headers={"Retry-After": str(SERVICE_RETRY_AFTER_S)},
-        service=error.service,
+        error.reason,
+        headers={"Retry-After": str(error.retry_after_s)},
+        service="workers",
     )
 
 
@@ -92,5 +123,6 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RequestValidationError, _validation)
     app.add_exception_handler(CoreError, _core)
     app.add_exception_handler(ServiceUnavailableError, _service)
+    app.add_exception_handler(UnavailableError, _unavailable)
     app.add_exception_handler(StarletteHTTPException, _http)
     app.add_exception_handler(Exception, _unexpected)

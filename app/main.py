@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import asyncio
 import json
 import logging
 import secrets
+import signal
+import threading
 import time
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
 from importlib.metadata import version
 from typing import Annotated, Any
 
@@ -16,7 +21,10 @@ from pydantic.json_schema import models_json_schema
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from app import errors
-from app.routers import health, plans, presets, simulate, studies
+from app.execution import Executor
+from app.jobs.runner import CeleryDispatcher, LocalRunner
+from app.jobs.store import store_for
+from app.routers import health, jobs, plans, presets, simulate, studies
 from app.schemas import PlanFeatureCollection, Problem
 from app.settings import Settings, get_settings
 
@@ -132,6 +140,84 @@ def require_api_key(
         )
 
 
+class Draining:
+    """After SIGTERM, a request that still reaches the server (a kept-alive connection) is
+    answered 503 at once and its connection closed; liveness still answers."""
+
+    def __init__(self, app: ASGIApp, executor: Executor) -> None:
+        self.app = app
+        self.executor = executor
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http" or not self.executor.draining or scope["path"] == "/healthz":
+            await self.app(scope, receive, send)
+            return
+        body = json.dumps(
+            errors.problem_body(503, "Service unavailable", "the server is shutting down")
+        ).encode()
+        await send(
+            {
+                "type": "http.response.start",
+                "status": 503,
+                "headers": [
+                    (b"content-type", errors.PROBLEM_JSON.encode()),
+                    (b"content-length", str(len(body)).encode()),
+                    (b"retry-after", b"1"),
+                    (b"connection", b"close"),
+                ],
+            }
+        )
+        await send({"type": "http.response.body", "body": body})
+
+
+def _drain_on_signals(executor: Executor) -> None:
+    """SIGTERM or SIGINT: start draining at once, then let the server's own handler (uvicorn's)
+    stop accepting connections and wait for the ones under way."""
+    if threading.current_thread() is not threading.main_thread():
+        return  # only the main thread may set handlers (tests run the app elsewhere)
+    loop = asyncio.get_running_loop()
+    tasks: set[asyncio.Task[None]] = set()
+
+    def start() -> None:
+        if not executor.draining:
+            task = loop.create_task(executor.drain())
+            tasks.add(task)
+
+    for number in (signal.SIGTERM, signal.SIGINT):
+        previous = signal.getsignal(number)
+
+        def handler(signum: int, frame: Any, previous: Any = previous) -> None:
+            loop.call_soon_threadsafe(start)
+            if callable(previous):
+                previous(signum, frame)
+
+        signal.signal(number, handler)
+
+
+@asynccontextmanager
+async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
+    settings: Settings = app.state.settings
+    executor: Executor = app.state.executor
+    _drain_on_signals(executor)
+    store = store_for(settings.database_url)
+    await asyncio.to_thread(store.migrate)
+    runner = (
+        CeleryDispatcher(store, settings)
+        if settings.broker_url is not None
+        else LocalRunner(store, executor, settings)
+    )
+    runner.start()
+    app.state.runner = runner
+    await executor.warm_up()
+    try:
+        yield
+    finally:
+        await runner.stop()
+        app.state.runner = None
+        if executor.draining:
+            executor.stop()
+
+
 def create_app(settings: Settings | None = None) -> FastAPI:
     """The ASGI application; ``settings`` overrides the environment (tests)."""
     settings = settings or get_settings()
@@ -142,6 +228,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         title="coldroute",
         version=version("coldroute"),
         description=DESCRIPTION,
+        lifespan=_lifespan,
         responses={
             status: {
                 "model": Problem,
@@ -157,9 +244,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         },
     )
     app.dependency_overrides[get_settings] = lambda: settings
+    app.state.settings = settings
+    app.state.executor = Executor(settings)
+    app.state.runner = None
     errors.install(app)
     v1 = APIRouter(prefix="/v1", dependencies=[Depends(require_api_key)])
-    for module in (plans, simulate, presets, studies):
+    for module in (plans, simulate, presets, studies, jobs):
         v1.include_router(module.router)
     app.include_router(v1)
     app.include_router(health.router)
@@ -171,6 +261,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             allow_headers=["*"],
         )
     app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
+    app.add_middleware(Draining, executor=app.state.executor)
     app.add_middleware(RequestLog)
     _add_response_schemas(app, [PlanFeatureCollection])
     return app

@@ -584,5 +584,79 @@ class Problem(ApiModel):
 class Health(ApiModel):
     """Liveness."""
 
-    status: Literal["ok"] = "ok"
-    version: str
+    status: Literal["ok"] = Field("ok", description="Always ok: the process answers.")
+    version: str = Field(..., description="Version of the service.")
+
+
+class Check(ApiModel):
+    """One dependency of the service."""
+
+    name: str = Field(..., description="workers, database, broker, osrm or weather.")
+    ok: bool = Field(..., description="Whether it answered.")
+    detail: str = Field(..., description="What was checked, or what went wrong.")
+    critical: bool = Field(
+        ...,
+        description="Whether the service is unready without it (the weather service is not: "
+        "plans fall back to the climatology).",
+    )
+
+
+class Readiness(ApiModel):
+    """Whether the service can take work, dependency by dependency."""
+
+    status: Literal["ready", "degraded", "unavailable"] = Field(
+        ...,
+        description="ready; degraded (a non-critical service is down); unavailable (503).",
+    )
+    checks: list[Check]
+
+
+JobType = Literal["plan", "scenarios"]
+JobStatus = Literal["queued", "running", "succeeded", "failed", "cancelled"]
+
+
+class JobSubmission(ApiModel):
+    """A job: the type and the body the synchronous endpoint would take."""
+
+    type: JobType = Field(
+        ..., description="plan: the body of POST /v1/plans; scenarios: of /v1/studies/scenarios."
+    )
+    request: dict[str, Any] = Field(
+        ...,
+        description="The request, exactly as for the synchronous endpoint; validated before "
+        "the job is accepted (422 naming request.… otherwise).",
+        json_schema_extra={
+            "oneOf": [
+                {"$ref": "#/components/schemas/PlanRequest"},
+                {"$ref": "#/components/schemas/ScenariosRequest"},
+            ]
+        },
+    )
+
+
+class JobSummary(ApiModel):
+    """A job's state."""
+
+    id: str = Field(..., description="The job's identifier (a UUID).")
+    type: JobType
+    status: JobStatus = Field(..., description="queued, running, succeeded, failed or cancelled.")
+    created_at: AwareDatetime = Field(..., description="When it was accepted (UTC).")
+    started_at: AwareDatetime | None = Field(None, description="When its last run began.")
+    finished_at: AwareDatetime | None = Field(None, description="When it ended.")
+    attempts: int = Field(..., description="Runs so far (a lost worker means another run).")
+
+
+class JobOut(JobSummary):
+    """A job, with its answer once it has one."""
+
+    result: PlanResponse | ScenariosResponse | None = Field(
+        None,
+        description="When succeeded: exactly what the synchronous endpoint returns.",
+    )
+    error: Problem | None = Field(None, description="When failed: why, as a problem document.")
+
+
+class JobList(ApiModel):
+    """Jobs, newest first."""
+
+    jobs: list[JobSummary]

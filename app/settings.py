@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from functools import lru_cache
 
 from pydantic import Field, SecretStr
@@ -13,7 +14,10 @@ class Settings(BaseSettings):
 
     model_config = SettingsConfigDict(env_prefix="COLDROUTE_", frozen=True)
 
-    host: str = Field("0.0.0.0", description="Interface uvicorn listens on.")
+    host: str = Field(
+        "127.0.0.1",
+        description="Interface the server listens on (make serve); 0.0.0.0 to serve the network.",
+    )
     port: int = Field(8000, ge=1, le=65535, description="Port uvicorn listens on.")
     log_level: str = Field("info", description="Python log level of the request log.")
     cors_origins: list[str] = Field(
@@ -32,6 +36,9 @@ class Settings(BaseSettings):
     )
     max_time_limit_s: float = Field(
         10.0, gt=0, description="Cap on a request's solver time_limit_s [s]."
+    )
+    max_job_time_limit_s: float = Field(
+        600.0, gt=0, description="Cap on a job's solver time_limit_s [s] (jobs may solve longer)."
     )
     osrm_url: str | None = Field(
         None,
@@ -64,6 +71,62 @@ class Settings(BaseSettings):
     weather_timeout_s: float = Field(
         5.0, gt=0, le=120, description="Timeout of one weather call [s]."
     )
+    workers: int = Field(
+        default_factory=lambda: os.cpu_count() or 1,
+        ge=1,
+        le=256,
+        description="Worker processes that solve and simulate (default: the CPU count).",
+    )
+    queue_size: int = Field(
+        64, ge=0, le=100_000, description="Requests that may wait for a worker (503 beyond)."
+    )
+    queue_deadline_s: float = Field(
+        30.0, gt=0, le=3600, description="Longest a request waits for a worker (503 beyond) [s]."
+    )
+    shutdown_grace_s: float = Field(
+        8.0,
+        ge=0,
+        le=300,
+        description="On SIGTERM, how long requests under way may finish before they are "
+        "answered 503 and the workers stopped [s].",
+    )
+    database_url: str = Field(
+        "sqlite:///coldroute.db",
+        description="Where jobs and results are kept (SQLAlchemy URL): a SQLite file beside "
+        "the server, or postgresql+psycopg://user@host/db.",
+    )
+    broker_url: str | None = Field(
+        None,
+        description="Celery broker (redis://127.0.0.1:6379/0): jobs go to Celery workers "
+        "(make worker) instead of the server's own pool. Needs a PostgreSQL database_url.",
+    )
+    job_slots: int | None = Field(
+        None,
+        ge=1,
+        le=256,
+        description="Jobs the server's own pool runs at once; default: all workers but one, "
+        "so synchronous requests keep a worker.",
+    )
+    job_retention_s: float = Field(
+        7 * 86_400.0, gt=0, description="How long finished jobs and results are kept [s]."
+    )
+    job_heartbeat_s: float = Field(
+        3.0, gt=0, le=600, description="How often a running job says it is alive [s]."
+    )
+    job_stale_after_s: float = Field(
+        15.0,
+        gt=0,
+        le=3600,
+        description="A running job silent this long lost its worker and is run again [s].",
+    )
+    job_max_attempts: int = Field(
+        3, ge=1, le=20, description="Runs of a job before it is failed (worker lost, router down)."
+    )
+
+    @property
+    def job_concurrency(self) -> int:
+        """Jobs the server's own pool runs at once."""
+        return self.job_slots or max(self.workers - 1, 1)
 
 
 @lru_cache

@@ -7,6 +7,7 @@ import os
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -74,40 +75,64 @@ def busy_core() -> Iterator[None]:
         burner.join(timeout=5)
 
 
-@contextmanager
-def running_server(env: dict[str, str] | None = None) -> Iterator[str]:
-    """The real service (uvicorn, a free loopback port) for the duration; yields its URL."""
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
-    environment = {k: v for k, v in os.environ.items() if not k.startswith("COLDROUTE_")}
-    process = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "uvicorn",
-            "app.main:app",
-            "--host",
-            "127.0.0.1",
-            "--port",
-            str(port),
-            "--log-level",
-            "warning",
-        ],
-        env=environment | {"COLDROUTE_LOG_LEVEL": "warning"} | (env or {}),
-        stdout=subprocess.DEVNULL,
-    )
-    url = f"http://127.0.0.1:{port}"
-    try:
-        for _ in range(150):
+class Server:
+    """The real service (``python -m app.serve``) on a free loopback port, with a database of
+    its own unless told otherwise."""
+
+    def __init__(self, env: dict[str, str] | None = None, database_dir: Path | None = None):
+        with socket.socket() as sock:
+            sock.bind(("127.0.0.1", 0))
+            self.port = int(sock.getsockname()[1])
+        self.url = f"http://127.0.0.1:{self.port}"
+        self._folder = None if database_dir else tempfile.TemporaryDirectory()
+        folder = database_dir or Path(self._folder.name)  # type: ignore[union-attr]
+        inherited = {k: v for k, v in os.environ.items() if not k.startswith("COLDROUTE_")}
+        self.env = (
+            inherited
+            | {
+                "COLDROUTE_LOG_LEVEL": "warning",
+                "COLDROUTE_HOST": "127.0.0.1",
+                "COLDROUTE_PORT": str(self.port),
+                "COLDROUTE_DATABASE_URL": f"sqlite:///{folder}/jobs.db",
+            }
+            | (env or {})
+        )
+        self.process: subprocess.Popen[bytes] | None = None
+
+    def start(self, timeout_s: float = 30.0) -> Server:
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "app.serve"],
+            env=self.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+        )
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError(f"the server exited: {self.process.stderr.read()!r}")  # type: ignore[union-attr]
             try:
-                if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
-                    break
+                if httpx.get(f"{self.url}/healthz", timeout=1).status_code == 200:
+                    return self
             except httpx.TransportError:
                 time.sleep(0.1)
-        else:
-            raise RuntimeError("the server did not start within 15 s")
-        yield url
+        raise RuntimeError(f"the server did not start within {timeout_s:g} s")
+
+    def stop(self) -> None:
+        if self.process is not None and self.process.poll() is None:
+            self.process.terminate()
+            self.process.wait(timeout=15)
+
+    def close(self) -> None:
+        self.stop()
+        if self._folder is not None:
+            self._folder.cleanup()
+
+
+@contextmanager
+def running_server(env: dict[str, str] | None = None) -> Iterator[str]:
+    """The real service for the duration; yields its URL."""
+    server = Server(env).start()
+    try:
+        yield server.url
     finally:
-        process.terminate()
-        process.wait(timeout=10)
+        server.close()

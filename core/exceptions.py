@@ -23,6 +23,10 @@ class CoreError(ValueError):
         self.message = message
         self.field = field
 
+    def __reduce__(self) -> tuple[type[CoreError], tuple[str, str | None]]:
+        # Errors cross process boundaries (worker pool, job queue) with their field.
+        return type(self), (self.message, self.field)
+
 
 class InvalidParameterError(CoreError):
     """A parameter or input array breaks its documented rule (sign, range, finiteness...)."""
@@ -60,3 +64,6 @@ class ServiceUnavailableError(Exception):
         super().__init__(message)
         self.service = service
         self.message = message
+
+    def __reduce__(self) -> tuple[type[ServiceUnavailableError], tuple[str, str]]:
+        return type(self), (self.service, self.message)

@@ -197,10 +197,7 @@ def plan(
         weather. When it fails the round is planned on the climatology and ``warnings`` says
         so.
     """
-    _check_stops(problem)
-    start, timezone_name = departure(
-        problem.date, problem.start_time, problem.timezone, problem.depot.lon
-    )
+    start, timezone_name = check(problem)
     places: list[Depot] = [problem.depot, *problem.stops]
     table = router.table(places) if router is not None and problem.matrix is None else None
     legs = build_legs(places, problem.matrix, table)
@@ -273,6 +270,20 @@ def _routes(router: RoadRouter, places: list[Depot], order: list[int]) -> list[L
 def _place_field(index: int) -> str:
     """The request field of place ``index`` (0 the depot)."""
     return "depot" if index == 0 else f"stops[{index - 1}]"
+
+
+def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
+    """Everything about a round that can be checked without solving it: unique stop ids, the
+    payload, the time zone and start time, the client's matrix. Raises
+    :class:`core.exceptions.CoreError` naming the field; returns the departure and the zone's
+    name."""
+    _check_stops(problem)
+    start, timezone_name = departure(
+        problem.date, problem.start_time, problem.timezone, problem.depot.lon
+    )
+    if problem.matrix is not None:
+        build_legs([problem.depot, *problem.stops], problem.matrix)
+    return start, timezone_name
 
 
 def _check_stops(problem: PlanProblem) -> None:

@@ -22,9 +22,9 @@ from matplotlib.figure import Figure
 from tqdm import tqdm
 
 from app.examples import PLAN_EXAMPLE
-from app.routers.plans import plan_problem
 from app.schemas import PlanRequest
 from app.settings import get_settings
+from app.work import plan_problem
 from core.clock import departure
 from core.cycles import generate_leg
 from core.params import (

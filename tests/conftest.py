@@ -4,6 +4,7 @@ Monaco extract and the local weather-API stand-in."""
 from __future__ import annotations
 
 import os
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -12,6 +13,11 @@ from hypothesis import settings
 
 from tests.weather_stub import StubServer
 from tools import osrm
+
+# The tests' jobs go to a database of their own, never to a coldroute.db in the checkout.
+os.environ.setdefault(
+    "COLDROUTE_DATABASE_URL", f"sqlite:///{tempfile.mkdtemp(prefix='coldroute-tests-')}/jobs.db"
+)
 
 # CI replays the same examples every run (a red CI must be reproducible); developers' runs
 # keep exploring new ones.

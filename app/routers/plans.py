@@ -4,52 +4,24 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Depends, Header
+from fastapi import APIRouter, Body, Depends, Header, Request
 from fastapi.responses import JSONResponse
 
-from app import connectors
+from app import work
 from app.examples import PLAN_EXAMPLE
+from app.execution import Executor
 from app.routers.results import plan_geojson, plan_response
-from app.schemas import PlanRequest, PlanResponse, clock_time
+from app.schemas import PlanRequest, PlanResponse
 from app.settings import Settings, get_settings
-from core.exceptions import LimitExceededError
-from core.plan import PlanProblem, PlanResult, plan
 
 router = APIRouter(tags=["plans"])
 GEOJSON = "application/geo+json"
 
 
-def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
-    """The core problem of a plan request, within the server's limits."""
-    if len(request.stops) > settings.max_stops:
-        raise LimitExceededError(
-            f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
-            "stops",
-        )
-    return PlanProblem(
-        date=request.date,
-        start_time=clock_time(request.start_time),
-        timezone=request.timezone,
-        depot=request.depot,
-        stops=request.stops,
-        van=request.van(),
-        weather=request.weather,
-        driver_aggressiveness=request.driver_aggressiveness,
-        traffic_density=request.traffic_density,
-        objective=request.objective,
-        matrix=request.matrix,
-        keep_order=request.keep_order,
-        time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
-    )
-
-
-def run_plan(request: PlanRequest, settings: Settings) -> PlanResult:
-    """Plan a request with the configured road router and weather service."""
-    return plan(
-        plan_problem(request, settings),
-        connectors.router(settings),
-        connectors.weather_service(settings),
-    )
+def executor(http: Request) -> Executor:
+    """The server's worker pool."""
+    pool: Executor = http.app.state.executor
+    return pool
 
 
 def wants_geojson(accept: str | None) -> bool:
@@ -87,7 +59,7 @@ def wants_geojson(accept: str | None) -> bool:
         }
     },
 )
-def create_plan(
+async def create_plan(
     request: Annotated[
         PlanRequest,
         Body(
@@ -99,7 +71,9 @@ def create_plan(
             }
         ),
     ],
+    http: Request,
     settings: Annotated[Settings, Depends(get_settings)],
+    pool: Annotated[Executor, Depends(executor)],
     accept: Annotated[
         str | None,
         Header(description="application/json (default) or application/geo+json for a map."),
@@ -107,8 +81,9 @@ def create_plan(
 ) -> Any:
     """Orders the stops (OR-Tools), simulates every leg and stop with the paper's model and says
     whether the battery holds out. With `COLDROUTE_OSRM_URL` set, distances, durations and each
-    leg's speed profile come from the OSRM road router."""
-    result = run_plan(request, settings)
+    leg's speed profile come from the OSRM road router. Solved in a worker process; when every
+    worker is busy the request waits in a bounded queue (503 with Retry-After beyond it)."""
+    result = await pool.run(work.run_plan, request, settings, disconnected=http.is_disconnected)
     if wants_geojson(accept):
         collection = plan_geojson(result, request.depot.lat, request.depot.lon)
         return JSONResponse(collection.model_dump(mode="json"), media_type=GEOJSON)

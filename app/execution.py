@@ -1,0 +1,233 @@
+"""Solving off the server's process: worker processes behind a bounded queue.
+
+OR-Tools' search and the simulation hold Python's GIL, so they run in a pool of worker
+*processes* (Pebble's ``ProcessPool``, spawned, niced below the server so that the event loop,
+``/healthz`` and the queue keep answering while every worker is busy). In front of the pool an
+asyncio queue holds the requests that wait for a worker:
+
+* at most ``queue_size`` wait; beyond, and after ``queue_deadline_s`` of waiting, a request is
+  answered 503 with ``Retry-After`` (:class:`UnavailableError`), never left hanging;
+* a client that disconnects while waiting gives up its place;
+* on SIGTERM (:meth:`Executor.drain`) waiting requests are answered 503 at once, the ones under
+  way may finish within ``shutdown_grace_s``, then their workers are stopped and they are
+  answered 503 too.
+
+Jobs (:mod:`app.jobs`) share the pool through :meth:`Executor.start`, which hands back the
+worker's future so that a running job can be stopped (Pebble terminates its process).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import multiprocessing
+import os
+import signal
+import threading
+import time
+from collections.abc import Awaitable, Callable
+from concurrent.futures import CancelledError as FutureCancelledError
+from concurrent.futures import Future
+from concurrent.futures import TimeoutError as FutureTimeoutError
+from functools import lru_cache
+from typing import Any, TypeVar
+
+from pebble import ProcessExpired, ProcessPool
+
+from app.settings import Settings
+
+T = TypeVar("T")
+#: Nice increment of the workers: the server's event loop comes first on a busy machine.
+WORKER_NICENESS = 5
+#: How often a waiting request checks for a free worker, its client and the shutdown [s].
+_POLL_S = 0.05
+
+
+class UnavailableError(Exception):
+    """The service cannot take this request now: 503 with ``Retry-After``.
+
+    Parameters
+    ----------
+    reason
+        Why, for the client.
+    retry_after_s
+        When to try again [s].
+    """
+
+    def __init__(self, reason: str, retry_after_s: int) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.retry_after_s = retry_after_s
+
+
+def _watch_parent(parent_pid: int) -> None:
+    """Exit when the server that started this worker is gone (even after SIGKILL)."""
+    while True:
+        time.sleep(1.0)
+        if os.getppid() != parent_pid:
+            os._exit(1)
+
+
+def _initialize_worker(parent_pid: int) -> None:
+    with contextlib.suppress(OSError):  # not permitted: keep the default priority
+        os.nice(WORKER_NICENESS)
+    # Stopping a worker must be instant even inside OR-Tools' C++ search (a Python-level
+    # handler would only run when the search returns): the operating system's default.
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True).start()
+    import app.work  # noqa: F401  (the first request should not pay for the imports)
+
+
+def _ping() -> int:
+    return os.getpid()
+
+
+@lru_cache(maxsize=4)
+def worker_pool(workers: int) -> ProcessPool:
+    """The process's pool of ``workers`` spawned processes (one per process and size)."""
+    return ProcessPool(
+        max_workers=workers,
+        context=multiprocessing.get_context("spawn"),
+        initializer=_initialize_worker,
+        initargs=(os.getpid(),),
+    )
+
+
+class Executor:
+    """The worker pool of one server and the queue in front of it."""
+
+    def __init__(self, settings: Settings) -> None:
+        self.settings = settings
+        self.waiting = 0
+        self.running = 0
+        self.draining = False
+        self._free: asyncio.Semaphore | None = None
+        self._underway: set[Future[Any]] = set()
+        self._stopped = False
+
+    @property
+    def pool(self) -> ProcessPool:
+        return worker_pool(self.settings.workers)
+
+    def _slots(self) -> asyncio.Semaphore:
+        if self._free is None:
+            self._free = asyncio.Semaphore(self.settings.workers)
+        return self._free
+
+    async def warm_up(self) -> None:
+        """Start every worker and have it import the code (about 2 s, once)."""
+        futures = [self.pool.schedule(_ping) for _ in range(self.settings.workers)]
+        await asyncio.gather(*(asyncio.wrap_future(f) for f in futures))
+
+    def alive(self) -> bool:
+        """Whether the pool runs and takes work."""
+        return not self._stopped and bool(self.pool.active)
+
+    async def run(
+        self,
+        fn: Callable[..., T],
+        *args: Any,
+        disconnected: Callable[[], Awaitable[bool]] | None = None,
+    ) -> T:
+        """``fn(*args)`` in a worker, after waiting in the bounded queue.
+
+        Raises :class:`UnavailableError` when the queue is full, the wait too long or the server
+        shutting down; ``fn``'s own exceptions come back as they were raised.
+        """
+        if self.draining:
+            raise UnavailableError("the server is shutting down", 1)
+        if self.waiting >= self.settings.queue_size:
+            raise UnavailableError(
+                f"all {self.settings.workers} workers are busy and {self.waiting} requests "
+                "wait; try again shortly",
+                max(int(self.settings.queue_deadline_s / 4), 1),
+            )
+        await self._acquire(disconnected, self.settings.queue_deadline_s)
+        try:
+            return await self._await(self._schedule(fn, args))
+        finally:
+            self._slots().release()
+
+    async def start(self, fn: Callable[..., T], *args: Any) -> Future[T]:
+        """Wait (without deadline) for a worker and start ``fn(*args)`` on it; the worker's
+        future, which :meth:`finish` awaits and ``cancel()`` stops (a job)."""
+        await self._acquire(None, None)
+        future = self._schedule(fn, args)
+        future.add_done_callback(lambda _: self._slots().release())
+        return future
+
+    async def finish(self, future: Future[T]) -> T:
+        """The result of a future :meth:`start` returned."""
+        return await self._await(future)
+
+    async def _acquire(
+        self, disconnected: Callable[[], Awaitable[bool]] | None, deadline_s: float | None
+    ) -> None:
+        slots = self._slots()
+        self.waiting += 1
+        waited = time.monotonic()
+        try:
+            while True:
+                if self.draining:
+                    raise UnavailableError("the server is shutting down", 1)
+                try:
+                    await asyncio.wait_for(slots.acquire(), _POLL_S)
+                    break
+                except TimeoutError:
+                    pass
+                if deadline_s is not None and time.monotonic() - waited > deadline_s:
+                    raise UnavailableError(
+                        f"no worker became free within {deadline_s:g} s; try again shortly",
+                        max(int(deadline_s / 4), 1),
+                    )
+                if disconnected is not None and await disconnected():
+                    raise asyncio.CancelledError("the client went away while waiting")
+        finally:
+            self.waiting -= 1
+        if self.draining:  # the shutdown began while this request got its worker
+            slots.release()
+            raise UnavailableError("the server is shutting down", 1)
+
+    def _schedule(self, fn: Callable[..., T], args: tuple[Any, ...]) -> Future[T]:
+        future: Future[T] = self.pool.schedule(fn, args=args)
+        self.running += 1
+        self._underway.add(future)
+
+        def forget(done: Future[T]) -> None:
+            self.running -= 1
+            self._underway.discard(done)
+
+        future.add_done_callback(forget)
+        return future
+
+    async def _await(self, future: Future[T]) -> T:
+        try:
+            return await asyncio.wrap_future(future)
+        except (asyncio.CancelledError, FutureCancelledError):
+            if future.cancelled() and self.draining:
+                raise UnavailableError("the server shut down before this finished", 1) from None
+            raise
+        except ProcessExpired:
+            raise UnavailableError("the worker running this was lost; try again", 1) from None
+        except FutureTimeoutError:
+            raise UnavailableError("the worker did not finish in time", 1) from None
+
+    async def drain(self) -> None:
+        """SIGTERM: refuse new work at once, let running work finish within the grace, then
+        stop the workers (their requests are answered 503)."""
+        self.draining = True
+        deadline = time.monotonic() + self.settings.shutdown_grace_s
+        while self._underway and time.monotonic() < deadline:
+            await asyncio.sleep(_POLL_S)
+        for future in list(self._underway):
+            future.cancel()
+        await asyncio.sleep(0)  # let the cancelled requests answer before the pool is stopped
+        await asyncio.to_thread(self.stop)
+
+    def stop(self) -> None:
+        """Stop the workers now."""
+        if not self._stopped:
+            self._stopped = True
+            self.pool.stop()  # type: ignore[no-untyped-call]
+            self.pool.join(timeout=0.5)
+            worker_pool.cache_clear()

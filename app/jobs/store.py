@@ -1,0 +1,354 @@
+"""Jobs and their results in a relational database (SQLAlchemy 2, Alembic migrations).
+
+SQLite by default (a file beside the server), PostgreSQL (psycopg 3) by URL. Every state
+change is one conditional ``UPDATE`` (``… WHERE status = 'queued'``), so two runners can never
+both take a job and a cancelled job is never overwritten by a late result.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import hashlib
+import json
+import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+from alembic import command
+from alembic.config import Config
+from sqlalchemy import Engine, create_engine, delete, event, select, text, update
+from sqlalchemy.exc import IntegrityError
+from sqlalchemy.orm import Session, sessionmaker
+
+from app.jobs.models import FINISHED, Job
+
+MIGRATIONS = Path(__file__).with_name("migrations")
+#: A lock key for migrations on PostgreSQL, so replicas starting together upgrade once.
+_MIGRATION_LOCK = 7_317_001
+
+
+def now() -> dt.datetime:
+    return dt.datetime.now(dt.UTC)
+
+
+def request_hash(job_type: str, request: dict[str, Any]) -> str:
+    """A fingerprint of what was asked, to tell a repeated Idempotency-Key from a reused one."""
+    canonical = json.dumps({"type": job_type, "request": request}, sort_keys=True)
+    return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class JobView:
+    """A job as read from the store."""
+
+    id: str
+    type: str
+    status: str
+    request: dict[str, Any]
+    request_hash: str
+    result: dict[str, Any] | None
+    error: dict[str, Any] | None
+    attempts: int
+    time_limit_s: float
+    runner: str | None
+    created_at: dt.datetime
+    started_at: dt.datetime | None
+    heartbeat_at: dt.datetime | None
+    finished_at: dt.datetime | None
+
+    @classmethod
+    def of(cls, job: Job) -> JobView:
+        return cls(
+            id=job.id,
+            type=job.type,
+            status=job.status,
+            request=job.request,
+            request_hash=job.request_hash,
+            result=job.result,
+            error=job.error,
+            attempts=job.attempts,
+            time_limit_s=job.time_limit_s,
+            runner=job.runner,
+            created_at=job.created_at,
+            started_at=job.started_at,
+            heartbeat_at=job.heartbeat_at,
+            finished_at=job.finished_at,
+        )
+
+
+class IdempotencyConflictError(Exception):
+    """An Idempotency-Key already names a job with a different request."""
+
+    def __init__(self, job: JobView) -> None:
+        super().__init__(job.id)
+        self.job = job
+
+
+class JobStore:
+    """The jobs table behind one database URL."""
+
+    def __init__(self, url: str) -> None:
+        self.url = url
+        sqlite = url.startswith("sqlite")
+        self.engine: Engine = create_engine(
+            url,
+            pool_pre_ping=True,
+            connect_args={"check_same_thread": False, "timeout": 30} if sqlite else {},
+        )
+        if sqlite:
+            event.listen(self.engine, "connect", _sqlite_pragmas)
+        self._session = sessionmaker(self.engine, expire_on_commit=False)
+        self._migrated = False
+
+    def migrate(self) -> None:
+        """Bring the schema to the newest Alembic revision (idempotent)."""
+        if self._migrated:
+            return
+        config = Config()
+        config.set_main_option("script_location", str(MIGRATIONS))
+        with self.engine.begin() as connection:
+            if connection.dialect.name == "postgresql":
+                connection.execute(text(f"SELECT pg_advisory_xact_lock({_MIGRATION_LOCK})"))
+            config.attributes["connection"] = connection
+            command.upgrade(config, "head")
+        self._migrated = True
+
+    @contextmanager
+    def _transaction(self) -> Iterator[Session]:
+        self.migrate()
+        with self._session.begin() as session:
+            yield session
+
+    def ping(self) -> None:
+        """Raise when the database cannot be reached."""
+        with self.engine.connect() as connection:
+            connection.execute(text("SELECT 1"))
+
+    def create(
+        self,
+        job_type: str,
+        request: dict[str, Any],
+        time_limit_s: float,
+        idempotency_key: str | None = None,
+    ) -> tuple[JobView, bool]:
+        """Store a queued job; with a key already used for the same request, the existing
+        job. Returns the job and whether it is new."""
+        fingerprint = request_hash(job_type, request)
+        if idempotency_key is not None:
+            existing = self.by_key(idempotency_key)
+            if existing is not None:
+                if existing.request_hash != fingerprint:
+                    raise IdempotencyConflictError(existing)
+                return existing, False
+        job = Job(
+            id=str(uuid.uuid4()),
+            type=job_type,
+            status="queued",
+            request=request,
+            request_hash=fingerprint,
+            idempotency_key=idempotency_key,
+            attempts=0,
+            time_limit_s=time_limit_s,
+            created_at=now(),
+        )
+        try:
+            with self._transaction() as session:
+                session.add(job)
+        except IntegrityError:  # the same key, sent twice at once: the other one won
+            existing = self.by_key(idempotency_key) if idempotency_key else None
+            if existing is None:
+                raise
+            if existing.request_hash != fingerprint:
+                raise IdempotencyConflictError(existing) from None
+            return existing, False
+        return JobView.of(job), True
+
+    def get(self, job_id: str) -> JobView | None:
+        with self._transaction() as session:
+            job = session.get(Job, job_id)
+            return None if job is None else JobView.of(job)
+
+    def by_key(self, key: str) -> JobView | None:
+        with self._transaction() as session:
+            job = session.scalars(select(Job).where(Job.idempotency_key == key)).first()
+            return None if job is None else JobView.of(job)
+
+    def recent(self, status: str | None = None, limit: int = 50) -> list[JobView]:
+        """The newest jobs first, optionally of one status."""
+        with self._transaction() as session:
+            query = select(Job).order_by(Job.created_at.desc(), Job.id).limit(limit)
+            if status is not None:
+                query = query.where(Job.status == status)
+            return [JobView.of(job) for job in session.scalars(query)]
+
+    def counts(self) -> dict[str, int]:
+        """Jobs per status."""
+        with self._transaction() as session:
+            rows = session.execute(text("SELECT status, COUNT(*) FROM jobs GROUP BY status"))
+            return {str(status): int(count) for status, count in rows}
+
+    def claim_next(self, runner: str) -> JobView | None:
+        """Take the oldest queued job for ``runner`` (queued → running)."""
+        with self._transaction() as session:
+            candidates = session.scalars(
+                select(Job.id)
+                .where(Job.status == "queued")
+                .order_by(Job.created_at)
+                .limit(5)
+                .with_for_update(skip_locked=True)
+            ).all()
+        for job_id in candidates:
+            job = self.claim(job_id, runner)
+            if job is not None:
+                return job
+        return None
+
+    def claim(self, job_id: str, runner: str, stale_after_s: float | None = None) -> JobView | None:
+        """Take one job for ``runner``: a queued one, or (with ``stale_after_s``) a running one
+        whose runner has been silent that long. None when it is not to be run."""
+        moment = now()
+        takeable = Job.status == "queued"
+        if stale_after_s is not None:
+            silent_since = moment - dt.timedelta(seconds=stale_after_s)
+            takeable = takeable | ((Job.status == "running") & (Job.heartbeat_at < silent_since))
+        with self._transaction() as session:
+            taken = session.execute(
+                update(Job)
+                .where(Job.id == job_id, takeable)
+                .values(
+                    status="running",
+                    runner=runner,
+                    started_at=moment,
+                    heartbeat_at=moment,
+                    attempts=Job.attempts + 1,
+                )
+            )
+            if taken.rowcount != 1:  # type: ignore[attr-defined]
+                return None
+            job = session.get(Job, job_id)
+            return None if job is None else JobView.of(job)
+
+    def heartbeat(self, job_ids: list[str], runner: str) -> None:
+        if not job_ids:
+            return
+        with self._transaction() as session:
+            session.execute(
+                update(Job)
+                .where(Job.id.in_(job_ids), Job.status == "running", Job.runner == runner)
+                .values(heartbeat_at=now())
+            )
+
+    def finish(
+        self,
+        job_id: str,
+        runner: str,
+        result: dict[str, Any] | None = None,
+        error: dict[str, Any] | None = None,
+    ) -> bool:
+        """Record the answer of a running job of ``runner``; False when it was cancelled or
+        taken over meanwhile (the answer is then dropped)."""
+        with self._transaction() as session:
+            done = session.execute(
+                update(Job)
+                .where(Job.id == job_id, Job.status == "running", Job.runner == runner)
+                .values(
+                    status="succeeded" if error is None else "failed",
+                    result=result,
+                    error=error,
+                    finished_at=now(),
+                )
+            )
+            return bool(done.rowcount == 1)  # type: ignore[attr-defined]
+
+    def requeue(self, job_id: str, runner: str | None = None) -> bool:
+        """Put a running job back in the queue (its runner lost it, or a retry)."""
+        with self._transaction() as session:
+            query = update(Job).where(Job.id == job_id, Job.status == "running")
+            if runner is not None:
+                query = query.where(Job.runner == runner)
+            done = session.execute(query.values(status="queued", runner=None, dispatched_at=None))
+            return bool(done.rowcount == 1)  # type: ignore[attr-defined]
+
+    def cancel(self, job_id: str) -> JobView | None:
+        """Cancel a queued or running job (a finished one stays as it is)."""
+        with self._transaction() as session:
+            session.execute(
+                update(Job)
+                .where(Job.id == job_id, Job.status.in_(("queued", "running")))
+                .values(status="cancelled", finished_at=now())
+            )
+            job = session.get(Job, job_id)
+            return None if job is None else JobView.of(job)
+
+    def cancelled_among(self, job_ids: list[str]) -> list[str]:
+        """Which of these jobs were cancelled."""
+        if not job_ids:
+            return []
+        with self._transaction() as session:
+            return list(
+                session.scalars(
+                    select(Job.id).where(Job.id.in_(job_ids), Job.status == "cancelled")
+                )
+            )
+
+    def stale(self, stale_after_s: float) -> list[JobView]:
+        """Running jobs whose runner has been silent for ``stale_after_s``."""
+        silent_since = now() - dt.timedelta(seconds=stale_after_s)
+        with self._transaction() as session:
+            query = select(Job).where(Job.status == "running", Job.heartbeat_at < silent_since)
+            return [JobView.of(job) for job in session.scalars(query)]
+
+    def undispatched(self, older_than_s: float) -> list[JobView]:
+        """Queued jobs not handed to the broker (or handed long ago, and not started)."""
+        before = now() - dt.timedelta(seconds=older_than_s)
+        with self._transaction() as session:
+            query = select(Job).where(
+                Job.status == "queued",
+                (Job.dispatched_at.is_(None)) | (Job.dispatched_at < before),
+            )
+            return [JobView.of(job) for job in session.scalars(query)]
+
+    def mark_dispatched(self, job_id: str) -> None:
+        with self._transaction() as session:
+            session.execute(update(Job).where(Job.id == job_id).values(dispatched_at=now()))
+
+    def fail_exhausted(self, job_id: str, max_attempts: int, error: dict[str, Any]) -> bool:
+        """Fail a queued or running job that has used its attempts."""
+        with self._transaction() as session:
+            done = session.execute(
+                update(Job)
+                .where(
+                    Job.id == job_id,
+                    Job.status.in_(("queued", "running")),
+                    Job.attempts >= max_attempts,
+                )
+                .values(status="failed", error=error, finished_at=now())
+            )
+            return bool(done.rowcount == 1)  # type: ignore[attr-defined]
+
+    def purge(self, retention_s: float) -> int:
+        """Delete jobs finished more than ``retention_s`` ago; how many."""
+        before = now() - dt.timedelta(seconds=retention_s)
+        with self._transaction() as session:
+            gone = session.execute(
+                delete(Job).where(Job.status.in_(FINISHED), Job.finished_at < before)
+            )
+            return int(gone.rowcount)  # type: ignore[attr-defined]
+
+
+def _sqlite_pragmas(connection: Any, _: Any) -> None:
+    # WAL lets the server read while a runner writes; the busy timeout waits out short locks.
+    cursor = connection.cursor()
+    cursor.execute("PRAGMA journal_mode=WAL")
+    cursor.execute("PRAGMA busy_timeout=30000")
+    cursor.close()
+
+
+@lru_cache(maxsize=8)
+def store_for(url: str) -> JobStore:
+    """One store (engine and connection pool) per database URL and process."""
+    return JobStore(url)

@@ -1,0 +1,191 @@
+"""POST/GET/DELETE /v1/jobs: rounds too big to wait on, and batch planning."""
+
+from __future__ import annotations
+
+import asyncio
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Body, Depends, Header, Path, Query, Request, Response
+from fastapi.exceptions import RequestValidationError
+from pydantic import BaseModel, ValidationError
+from starlette.exceptions import HTTPException
+
+from app.examples import PLAN_EXAMPLE
+from app.jobs.store import IdempotencyConflictError, JobStore, JobView, store_for
+from app.schemas import (
+    JobList,
+    JobOut,
+    JobStatus,
+    JobSubmission,
+    JobSummary,
+    PlanRequest,
+    ScenariosRequest,
+)
+from app.settings import Settings, get_settings
+from app.work import check_job
+from core.exceptions import CoreError
+
+router = APIRouter(prefix="/jobs", tags=["jobs"])
+REQUEST_MODELS: dict[str, type[BaseModel]] = {"plan": PlanRequest, "scenarios": ScenariosRequest}
+
+
+def job_store(settings: Annotated[Settings, Depends(get_settings)]) -> JobStore:
+    return store_for(settings.database_url)
+
+
+def _validated(submission: JobSubmission, settings: Settings) -> PlanRequest | ScenariosRequest:
+    """The job's request as the synchronous endpoint would validate it, fields named under
+    ``request.``."""
+    try:
+        request = REQUEST_MODELS[submission.type].model_validate(submission.request)
+    except ValidationError as error:
+        raise RequestValidationError(
+            [e | {"loc": ("body", "request", *e["loc"])} for e in error.errors()]
+        ) from None
+    assert isinstance(request, PlanRequest | ScenariosRequest)
+    try:
+        check_job(submission.type, request, settings)
+    except CoreError as error:
+        field = f"request.{error.field}" if error.field else "request"
+        raise type(error)(error.message, field) from None
+    return request
+
+
+def _summary(job: JobView) -> dict[str, Any]:
+    return {
+        "id": job.id,
+        "type": job.type,
+        "status": job.status,
+        "created_at": job.created_at,
+        "started_at": job.started_at,
+        "finished_at": job.finished_at,
+        "attempts": job.attempts,
+    }
+
+
+def _out(job: JobView) -> JobOut:
+    return JobOut.model_validate(_summary(job) | {"result": job.result, "error": job.error})
+
+
+def _get(store: JobStore, job_id: str) -> JobView:
+    job = store.get(job_id)
+    if job is None:
+        raise HTTPException(404, f"no job {job_id}")
+    return job
+
+
+@router.post(
+    "",
+    operation_id="createJob",
+    summary="Submit a plan or a scenario study to run in the background",
+    status_code=202,
+    responses={
+        200: {"model": JobOut, "description": "The job an Idempotency-Key already named."},
+        202: {"description": "Accepted; poll Location."},
+        409: {"description": "The Idempotency-Key names a job with another request."},
+    },
+)
+async def create_job(
+    submission: Annotated[
+        JobSubmission,
+        Body(
+            openapi_examples={
+                "plan": {
+                    "summary": "The Vienna round as a job",
+                    "value": {"type": "plan", "request": PLAN_EXAMPLE},
+                }
+            }
+        ),
+    ],
+    http: Request,
+    response: Response,
+    settings: Annotated[Settings, Depends(get_settings)],
+    store: Annotated[JobStore, Depends(job_store)],
+    idempotency_key: Annotated[
+        str | None,
+        Header(
+            max_length=255,
+            description="Repeat a submission safely: the same key returns the same job.",
+        ),
+    ] = None,
+) -> JobOut:
+    """Validates the request as the synchronous endpoint would (422 naming the field), stores
+    the job and answers at once with its id; `GET /v1/jobs/{id}` tells its state and, when it
+    has succeeded, its result — exactly what the synchronous endpoint returns."""
+    request = _validated(submission, settings)
+    time_limit_s = min(
+        request.time_limit_s if isinstance(request, PlanRequest) else request.plan.time_limit_s,
+        settings.max_job_time_limit_s,
+    )
+    try:
+        job, new = await asyncio.to_thread(
+            store.create,
+            submission.type,
+            request.model_dump(mode="json", exclude_unset=True),
+            time_limit_s,
+            idempotency_key,
+        )
+    except IdempotencyConflictError as conflict:
+        raise HTTPException(
+            409,
+            f"Idempotency-Key {idempotency_key!r} already names job {conflict.job.id}, which "
+            "was submitted with a different request",
+        ) from None
+    runner = getattr(http.app.state, "runner", None)
+    if new and runner is not None:
+        if hasattr(runner, "dispatch"):
+            await asyncio.to_thread(runner.dispatch, job)
+        runner.wake()
+    response.status_code = 202 if new else 200
+    response.headers["Location"] = f"/v1/jobs/{job.id}"
+    return _out(job)
+
+
+@router.get("", operation_id="listJobs", summary="Jobs, newest first")
+async def list_jobs(
+    store: Annotated[JobStore, Depends(job_store)],
+    status: Annotated[JobStatus | None, Query(description="Only jobs in this state.")] = None,
+    limit: Annotated[int, Query(ge=1, le=500, description="At most this many.")] = 50,
+) -> JobList:
+    """The newest jobs first, without their results."""
+    jobs = await asyncio.to_thread(store.recent, status, limit)
+    return JobList(jobs=[JobSummary.model_validate(_summary(job)) for job in jobs])
+
+
+JobId = Annotated[str, Path(max_length=64, description="The job's id.")]
+
+
+@router.get(
+    "/{job_id}",
+    operation_id="getJob",
+    summary="A job's state and result",
+    responses={404: {"description": "No such job (or it expired)."}},
+)
+async def get_job(job_id: JobId, store: Annotated[JobStore, Depends(job_store)]) -> JobOut:
+    """Its status and timestamps; its result when it succeeded, its error when it failed."""
+    return _out(await asyncio.to_thread(_get, store, job_id))
+
+
+@router.delete(
+    "/{job_id}",
+    operation_id="cancelJob",
+    summary="Cancel a job",
+    responses={
+        404: {"description": "No such job (or it expired)."},
+        409: {"description": "The job has already ended."},
+    },
+)
+async def cancel_job(
+    job_id: JobId, http: Request, store: Annotated[JobStore, Depends(job_store)]
+) -> JobOut:
+    """A queued job never runs; a running one is stopped (its worker process is terminated).
+    A job that has already ended cannot be cancelled (409)."""
+    before = await asyncio.to_thread(_get, store, job_id)
+    if before.status in ("succeeded", "failed", "cancelled"):
+        raise HTTPException(409, f"job {job_id} has already ended ({before.status})")
+    job = await asyncio.to_thread(store.cancel, job_id)
+    assert job is not None
+    runner = getattr(http.app.state, "runner", None)
+    if runner is not None:
+        runner.wake()
+    return _out(job)

@@ -1,0 +1,246 @@
+"""The work the service does, as plain functions of a validated request and the settings.
+
+They run in the worker processes (:mod:`app.execution`) for the synchronous endpoints, and in
+the job runners (the server's own pool or Celery workers) for ``/v1/jobs``; every argument and
+every result pickles. A job's result is exactly what the synchronous endpoint returns.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+
+from app import connectors
+from app.routers import results
+from app.schemas import (
+    ConsumptionWhPerKm,
+    PlanRequest,
+    PowerSeries,
+    ScenarioCellOut,
+    ScenariosRequest,
+    ScenariosResponse,
+    Series,
+    SimulateRequest,
+    SimulateResponse,
+    SpeedPointOut,
+    SpeedSweepRequest,
+    SpeedSweepResponse,
+    clock_time,
+)
+from app.settings import Settings
+from core.clock import departure
+from core.cycles import generate_leg
+from core.exceptions import CoreError, LimitExceededError
+from core.params import STREET_TYPES
+from core.plan import PlanProblem, PlanResult, check, plan
+from core.simulate import check_trace, simulate
+from core.studies import default_seasons, scenario_grid, speed_sweep
+from core.weather import forecast_for
+
+JobType = Literal["plan", "scenarios"]
+#: Shortest distance for which energy per km is reported [m].
+MIN_DISTANCE_FOR_PER_KM_M = 1.0
+
+
+def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
+    """The core problem of a plan request, within the server's limits."""
+    if len(request.stops) > settings.max_stops:
+        raise LimitExceededError(
+            f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
+            "stops",
+        )
+    return PlanProblem(
+        date=request.date,
+        start_time=clock_time(request.start_time),
+        timezone=request.timezone,
+        depot=request.depot,
+        stops=request.stops,
+        van=request.van(),
+        weather=request.weather,
+        driver_aggressiveness=request.driver_aggressiveness,
+        traffic_density=request.traffic_density,
+        objective=request.objective,
+        matrix=request.matrix,
+        keep_order=request.keep_order,
+        time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
+    )
+
+
+def run_plan(request: PlanRequest, settings: Settings) -> PlanResult:
+    """Plan a round with the configured road router and weather service."""
+    return plan(
+        plan_problem(request, settings),
+        connectors.router(settings),
+        connectors.weather_service(settings),
+    )
+
+
+def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResponse:
+    """Energy of one speed trace, sent or generated (``POST /v1/simulate``)."""
+    van = request.van()
+    if request.cycle is not None:
+        cycle = request.cycle
+        street = STREET_TYPES[cycle.street_type]
+        # Check the size before generating: a trace at least as long as cruising at v̄.
+        if cycle.distance_m / street.mean_speed_mps / request.dt_s > settings.max_trace_samples:
+            raise LimitExceededError(
+                f"a {cycle.distance_m:g} m {cycle.street_type} trace at dt_s {request.dt_s:g} "
+                f"has more than {settings.max_trace_samples} samples",
+                "cycle.distance_m",
+            )
+        speed = generate_leg(
+            cycle.distance_m,
+            street,
+            cycle.driver_aggressiveness,
+            van.vehicle.max_acceleration_mps2,
+            cycle.traffic_density,
+            request.dt_s,
+        )
+    else:
+        speed = np.asarray(request.speed_mps, dtype=float)
+    if speed.size > settings.max_trace_samples:
+        raise LimitExceededError(
+            f"the trace has {speed.size} samples; this server simulates at most "
+            f"{settings.max_trace_samples}",
+            "speed_mps" if request.cycle is None else "cycle.distance_m",
+        )
+    check_trace(speed, request.dt_s)  # before asking the weather service for its span
+    weather, warnings = forecast_for(
+        request.weather,
+        connectors.weather_service(settings),
+        request.location.lat,
+        request.location.lon,
+        request.start,
+        (speed.size - 1) * request.dt_s,
+    )
+    result = simulate(
+        speed,
+        request.dt_s,
+        request.start,
+        request.location,
+        van,
+        grade=request.grade,
+        weather=weather,
+        door_openings=request.door_openings,
+        parked=request.parked,
+    )
+    km = result.distance_m / 1000
+    # Per-km figures of a trace that (nearly) stands still mean nothing: null below a metre.
+    moved = result.distance_m >= MIN_DISTANCE_FOR_PER_KM_M
+    per_km = {k: (v * 1000 / km if moved else None) for k, v in result.energy_kwh.items()}
+    series = None
+    if request.include_series:
+        series = Series(
+            time_s=result.time_s.tolist(),
+            speed_mps=result.speed_mps.tolist(),
+            power_w=PowerSeries(**{k: [0.0, *p.tolist()] for k, p in result.power_w.items()}),
+            soc=result.soc.tolist(),
+        )
+    dynamic = van.cargo_box.mode == "dynamic"
+    return SimulateResponse(
+        distance_m=result.distance_m,
+        duration_s=result.duration_s,
+        energy_kwh=results.energy(result.energy_kwh),
+        consumption_wh_per_km=ConsumptionWhPerKm(**per_km),
+        battery=results.battery(result.battery, None, result.battery_loss_kwh),
+        weather=results.weather(result.weather, result.weather_source, result.weather_days),
+        box=results.box(
+            result.box.max_temperature_c if dynamic else None,
+            result.box.minutes_above_limit if dynamic else None,
+        ),
+        series=series,
+        grid_kwh=result.grid_kwh,
+        warnings=warnings,
+    )
+
+
+def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepResponse:
+    """Energy per km at each constant speed (``POST /v1/studies/speed-sweep``)."""
+    start, _ = departure(
+        request.date, clock_time(request.start_time), request.timezone, request.location.lon
+    )
+    sweep = speed_sweep(
+        request.speeds_kmh,
+        request.distance_m,
+        start,
+        request.location,
+        request.van(),
+        request.weather,
+        request.driver_aggressiveness,
+        request.traffic_density,
+    )
+    return SpeedSweepResponse(
+        points=[
+            SpeedPointOut(
+                speed_kmh=p.speed_kmh, energy_wh_per_km=ConsumptionWhPerKm(**p.energy_wh_per_km)
+            )
+            for p in sweep.points
+        ],
+        optimum_speed_kmh=sweep.optimum_speed_kmh,
+    )
+
+
+def check_scenarios(request: ScenariosRequest, settings: Settings) -> None:
+    """A scenario grid within the server's limit of cells × stops."""
+    seasons = request.seasons or default_seasons(request.plan.date.year)
+    n_cells = (
+        len(seasons)
+        * len(request.driver_aggressiveness or [0] * 3)
+        * len(request.traffic_density or [0] * 2)
+    )
+    if n_cells * len(request.plan.stops) > settings.max_study_cell_stops:
+        raise LimitExceededError(
+            f"{n_cells} cells of {len(request.plan.stops)} stops; this server evaluates at most "
+            f"{settings.max_study_cell_stops} cell-stops per study",
+            "plan.stops",
+        )
+
+
+def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosResponse:
+    """One round over seasons × drivers × traffic (``POST /v1/studies/scenarios``)."""
+    check_scenarios(request, settings)
+    seasons = request.seasons or default_seasons(request.plan.date.year)
+    grid = scenario_grid(
+        plan_problem(request.plan, settings),
+        seasons,
+        request.driver_aggressiveness,
+        request.traffic_density,
+        router=connectors.router(settings),
+        weather_service=connectors.weather_service(settings),
+    )
+    return ScenariosResponse(
+        tour=grid.tour,
+        baseline_energy_kwh=results.energy(grid.baseline_energy_kwh),
+        cells=[
+            ScenarioCellOut(**(vars(c) | {"energy_kwh": results.energy(c.energy_kwh)}))
+            for c in grid.cells
+        ],
+    )
+
+
+def check_job(
+    job_type: JobType, request: PlanRequest | ScenariosRequest, settings: Settings
+) -> None:
+    """Refuse at submission what would fail at once: everything but the solve itself."""
+    if isinstance(request, PlanRequest):
+        check(plan_problem(request, settings))
+        return
+    check_scenarios(request, settings)
+    try:
+        check(plan_problem(request.plan, settings))
+    except CoreError as error:
+        raise type(error)(error.message, f"plan.{error.field}" if error.field else "plan") from None
+
+
+def run_job(job_type: JobType, request: dict[str, Any], settings: Settings) -> dict[str, Any]:
+    """A job's result as JSON: exactly the synchronous endpoint's answer (jobs may solve up to
+    ``max_job_time_limit_s``)."""
+    settings = settings.model_copy(update={"max_time_limit_s": settings.max_job_time_limit_s})
+    if job_type == "plan":
+        plan_request = PlanRequest.model_validate(request)
+        answer = results.plan_response(
+            run_plan(plan_request, settings), plan_request.include_geometry
+        )
+        return answer.model_dump(mode="json")
+    return run_scenarios(ScenariosRequest.model_validate(request), settings).model_dump(mode="json")

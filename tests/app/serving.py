@@ -1,0 +1,56 @@
+"""Helpers of the serving tests: real servers in subprocesses, long rounds, worker processes."""
+
+from __future__ import annotations
+
+import copy
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from app.examples import PLAN_EXAMPLE
+
+
+def long_plan(n_stops: int, time_limit_s: float, seed: int = 1) -> dict[str, Any]:
+    """A round whose solve takes its whole ``time_limit_s`` (too many stops to prove)."""
+    rng = np.random.default_rng(seed)
+    body = copy.deepcopy(PLAN_EXAMPLE)
+    body["stops"] = [
+        {
+            "id": f"S{i}",
+            "lat": 48.21 + rng.uniform(-0.05, 0.05),
+            "lon": 16.37 + rng.uniform(-0.08, 0.08),
+            "service_time_s": 120,
+            "door_open_s": 30,
+            "delivery_kg": 1,
+        }
+        for i in range(n_stops)
+    ]
+    body["time_limit_s"] = time_limit_s
+    body["objective"] = "distance"
+    return body
+
+
+def children(pid: int) -> list[int]:
+    """Direct child processes of ``pid`` (Linux /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            parent = int(stat.rsplit(")", 1)[1].split()[1])
+            if parent == pid:
+                found.append(int(entry.name))
+    return found
+
+
+def alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    stat = Path(f"/proc/{pid}/stat")
+    return stat.exists() and stat.read_text().rsplit(")", 1)[1].split()[0] != "Z"

@@ -1,0 +1,157 @@
+"""Scale-out: jobs through Celery workers on Redis, with PostgreSQL — the real services of the
+test machines (127.0.0.1:5432 database ``test``, 127.0.0.1:6379), real worker processes."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+import uuid
+
+import httpx
+import psycopg
+import pytest
+import redis
+
+from app.examples import PLAN_EXAMPLE
+from benchmarks.common import Server
+from tests.app.serving import children, long_plan
+from tests.app.test_jobs import _cpu_busy, submit, wait_for
+
+POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
+REDIS_DB = 11
+
+
+@pytest.fixture(scope="module")
+def services():
+    """A schema of our own in PostgreSQL and an empty Redis database."""
+    schema = f"coldroute_{uuid.uuid4().hex[:10]}"
+    with psycopg.connect(POSTGRES, autocommit=True) as connection:
+        connection.execute(f"CREATE SCHEMA {schema}")
+    broker = f"redis://127.0.0.1:6379/{REDIS_DB}"
+    redis.Redis.from_url(broker).flushdb()
+    env = {
+        "COLDROUTE_DATABASE_URL": "postgresql+psycopg://postgres@127.0.0.1:5432/test"
+        f"?options=-csearch_path%3D{schema}",
+        "COLDROUTE_BROKER_URL": broker,
+        "COLDROUTE_JOB_HEARTBEAT_S": "0.5",
+        "COLDROUTE_JOB_STALE_AFTER_S": "3",
+        "COLDROUTE_WORKERS": "1",
+    }
+    yield env
+    redis.Redis.from_url(broker).flushdb()
+    with psycopg.connect(POSTGRES, autocommit=True) as connection:
+        connection.execute(f"DROP SCHEMA {schema} CASCADE")
+
+
+class Worker:
+    """``celery -A app.jobs.worker worker --pool=threads`` with one worker process (as
+    ``make worker``), in its own process group."""
+
+    def __init__(self, env: dict[str, str], name: str) -> None:
+        inherited = {k: v for k, v in os.environ.items() if not k.startswith("COLDROUTE_")}
+        self.process = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "celery",
+                "-A",
+                "app.jobs.worker",
+                "worker",
+                "--pool=threads",
+                "--concurrency=1",
+                "--loglevel=WARNING",
+                "--without-gossip",
+                "--without-mingle",
+                "-n",
+                f"{name}@%h",
+            ],
+            env=inherited | env,
+            start_new_session=True,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+
+    def busy(self) -> bool:
+        return any(_cpu_busy(pid) for pid in children(self.process.pid))
+
+    def kill(self) -> None:
+        os.killpg(self.process.pid, signal.SIGKILL)
+        self.process.wait()
+
+    def stop(self) -> None:
+        if self.process.poll() is None:
+            os.killpg(self.process.pid, signal.SIGTERM)
+            try:
+                self.process.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                self.kill()
+
+
+@pytest.fixture(scope="module")
+def workers(services):
+    started = [Worker(services, f"w{i}") for i in (1, 2)]
+    yield started
+    for worker in started:
+        worker.stop()
+
+
+@pytest.fixture(scope="module")
+def server(services, workers):
+    started = Server(services).start()
+    yield started
+    started.close()
+
+
+def test_jobs_run_on_the_celery_workers(server, workers):
+    ready = httpx.get(f"{server.url}/readyz").json()
+    assert {c["name"] for c in ready["checks"]} >= {"workers", "database", "broker"}
+    assert ready["status"] == "ready"
+    ids = [
+        submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"] for _ in range(4)
+    ]
+    done = [wait_for(server.url, job_id, timeout=90) for job_id in ids]
+    assert [job["status"] for job in done] == ["succeeded"] * 4
+    direct = httpx.post(f"{server.url}/v1/plans", json=PLAN_EXAMPLE, timeout=30).json()
+    assert done[0]["result"]["tour"] == direct["tour"]
+
+
+def test_a_worker_killed_mid_job_leaves_it_to_another(server, workers):
+    job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 6)}).json()["id"]
+    wait_for(server.url, job_id, states=("running",), timeout=60)
+    time.sleep(1.0)
+    running = next(w for w in workers if w.busy())
+    running.kill()
+    done = wait_for(server.url, job_id, timeout=120)
+    assert done["status"] == "succeeded" and done["attempts"] == 2
+    workers.remove(running)
+
+
+def test_sigkill_of_the_server_loses_no_job(services, workers):
+    first = Server(services).start()
+    ids = [
+        submit(first.url, {"type": "plan", "request": long_plan(100, 2, seed=s)}).json()["id"]
+        for s in range(3)
+    ]
+    first.process.send_signal(signal.SIGKILL)
+    first.process.wait()
+    second = Server(services).start()
+    try:
+        done = [wait_for(second.url, job_id, timeout=120) for job_id in ids]
+        assert [job["status"] for job in done] == ["succeeded"] * 3
+    finally:
+        second.close()
+        first.close()
+
+
+def test_cancel_a_running_celery_job(server, workers):
+    job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 30)}).json()["id"]
+    wait_for(server.url, job_id, states=("running",), timeout=60)
+    stopped_at = time.monotonic()
+    assert httpx.delete(f"{server.url}/v1/jobs/{job_id}").json()["status"] == "cancelled"
+    following = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+    assert wait_for(server.url, following, timeout=60)["status"] == "succeeded"
+    assert time.monotonic() - stopped_at < 20
+    assert httpx.get(f"{server.url}/v1/jobs/{job_id}").json()["status"] == "cancelled"

@@ -1,0 +1,224 @@
+"""Async jobs on the server's own pool and SQLite: the real server in a subprocess."""
+
+from __future__ import annotations
+
+import copy
+import os
+import signal
+import tempfile
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+
+from app.examples import PLAN_EXAMPLE, SCENARIOS_EXAMPLE
+from benchmarks.common import Server
+from tests.app.serving import alive, children, long_plan
+
+FAST = {
+    "COLDROUTE_WORKERS": "2",
+    "COLDROUTE_JOB_SLOTS": "1",
+    "COLDROUTE_JOB_HEARTBEAT_S": "0.5",
+    "COLDROUTE_JOB_STALE_AFTER_S": "2",
+}
+
+
+@pytest.fixture(scope="module")
+def server():
+    started = Server(FAST).start()
+    yield started
+    started.close()
+
+
+def submit(url: str, body: dict, key: str | None = None) -> httpx.Response:
+    headers = {"Idempotency-Key": key} if key else {}
+    return httpx.post(f"{url}/v1/jobs", json=body, headers=headers, timeout=30)
+
+
+def wait_for(url: str, job_id: str, states=("succeeded", "failed", "cancelled"), timeout=60):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        job = httpx.get(f"{url}/v1/jobs/{job_id}", timeout=10).json()
+        if job["status"] in states:
+            return job
+        time.sleep(0.2)
+    raise AssertionError(f"job {job_id} still {job['status']} after {timeout} s")
+
+
+def test_a_plan_job_answers_what_the_endpoint_answers(server):
+    response = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE})
+    assert response.status_code == 202
+    job = response.json()
+    assert job["status"] == "queued" and job["type"] == "plan" and job["created_at"]
+    assert response.headers["Location"] == f"/v1/jobs/{job['id']}"
+    done = wait_for(server.url, job["id"])
+    assert done["status"] == "succeeded" and done["attempts"] == 1 and done["error"] is None
+    assert done["started_at"] >= done["created_at"] and done["finished_at"] >= done["started_at"]
+    direct = httpx.post(f"{server.url}/v1/plans", json=PLAN_EXAMPLE, timeout=30).json()
+    for answer in (done["result"], direct):
+        answer["solver"].pop("runtime_s")
+    assert done["result"] == direct
+
+
+def test_a_scenarios_job(server):
+    done = wait_for(
+        server.url,
+        submit(server.url, {"type": "scenarios", "request": SCENARIOS_EXAMPLE}).json()["id"],
+    )
+    assert done["status"] == "succeeded" and len(done["result"]["cells"]) == 12
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        (
+            {"type": "plan", "request": PLAN_EXAMPLE | {"depot": {"lat": 99, "lon": 16}}},
+            "request.depot.lat",
+        ),
+        (
+            {
+                "type": "plan",
+                "request": PLAN_EXAMPLE | {"stops": [PLAN_EXAMPLE["stops"][0]] * 2},
+            },
+            "request.stops[1].id",
+        ),
+        (
+            {"type": "plan", "request": PLAN_EXAMPLE | {"timezone": "Mars/Olympus"}},
+            "request.timezone",
+        ),
+        (
+            {
+                "type": "scenarios",
+                "request": SCENARIOS_EXAMPLE
+                | {"plan": PLAN_EXAMPLE | {"date": "2026-03-29", "start_time": "02:30"}},
+            },
+            "request.plan.start_time",
+        ),
+        ({"type": "fleet", "request": PLAN_EXAMPLE}, "type"),
+        ({"type": "plan"}, "request"),
+    ],
+)
+def test_bad_input_is_a_422_at_submission(server, body, field):
+    response = submit(server.url, body)
+    assert response.status_code == 422
+    assert response.headers["content-type"] == "application/problem+json"
+    assert any(e["field"] == field for e in response.json()["errors"]), response.json()
+
+
+def test_an_idempotency_key_returns_the_same_job(server):
+    key = f"nightly-{time.time_ns()}"
+    first = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}, key)
+    again = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}, key)
+    assert (first.status_code, again.status_code) == (202, 200)
+    assert again.json()["id"] == first.json()["id"]
+    other = copy.deepcopy(PLAN_EXAMPLE) | {"driver_aggressiveness": 1.0}
+    conflict = submit(server.url, {"type": "plan", "request": other}, key)
+    assert conflict.status_code == 409 and first.json()["id"] in conflict.json()["detail"]
+
+
+def test_listing_and_unknown_jobs(server):
+    ids = [
+        submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"] for _ in range(3)
+    ]
+    for job_id in ids:
+        wait_for(server.url, job_id)
+    listed = httpx.get(f"{server.url}/v1/jobs", params={"limit": 2}).json()["jobs"]
+    assert [j["id"] for j in listed] == ids[::-1][:2]
+    assert "result" not in listed[0]
+    succeeded = httpx.get(f"{server.url}/v1/jobs", params={"status": "succeeded"}).json()["jobs"]
+    assert set(ids) <= {j["id"] for j in succeeded}
+    assert httpx.get(f"{server.url}/v1/jobs", params={"status": "lost"}).status_code == 422
+    missing = httpx.get(f"{server.url}/v1/jobs/no-such-job")
+    assert (
+        missing.status_code == 404 and missing.headers["content-type"] == "application/problem+json"
+    )
+
+
+def test_cancel_a_queued_and_a_running_job(server):
+    running = submit(server.url, {"type": "plan", "request": long_plan(300, 30)}).json()["id"]
+    wait_for(server.url, running, states=("running",))
+    queued = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+    time.sleep(0.5)
+    assert httpx.get(f"{server.url}/v1/jobs/{queued}").json()["status"] == "queued"  # one slot
+    cancelled = httpx.delete(f"{server.url}/v1/jobs/{queued}").json()
+    assert cancelled["status"] == "cancelled"
+    stopped_at = time.monotonic()
+    assert httpx.delete(f"{server.url}/v1/jobs/{running}").json()["status"] == "cancelled"
+    # the running job's worker is stopped: the next job starts at once, not after 30 s
+    following = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+    assert wait_for(server.url, following)["status"] == "succeeded"
+    assert time.monotonic() - stopped_at < 10
+    never = httpx.get(f"{server.url}/v1/jobs/{queued}").json()
+    assert (
+        never["status"] == "cancelled" and never["started_at"] is None and never["result"] is None
+    )
+    assert httpx.get(f"{server.url}/v1/jobs/{running}").json()["result"] is None
+    assert httpx.delete(f"{server.url}/v1/jobs/{following}").status_code == 409
+
+
+def test_a_worker_killed_mid_job_runs_it_again(server):
+    job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 4)}).json()["id"]
+    wait_for(server.url, job_id, states=("running",))
+    time.sleep(1.0)
+    busy = [pid for pid in children(server.process.pid) if _cpu_busy(pid)]
+    assert busy, "no worker is solving"
+    os.kill(busy[0], signal.SIGKILL)
+    done = wait_for(server.url, job_id)
+    assert done["status"] == "succeeded" and done["attempts"] == 2
+
+
+def _cpu_busy(pid: int) -> bool:
+    """Whether a process used CPU in the last 0.3 s (the worker that solves)."""
+
+    def ticks() -> int:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return int(fields[11]) + int(fields[12])
+
+    try:
+        before = ticks()
+        time.sleep(0.3)
+        return ticks() - before > 10
+    except (OSError, IndexError):
+        return False
+
+
+def test_sigkill_and_restart_lose_no_job():
+    with tempfile.TemporaryDirectory() as folder:
+        first = Server(FAST, database_dir=Path(folder)).start()
+        done_before = submit(first.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+        wait_for(first.url, done_before)
+        pending = [
+            submit(first.url, {"type": "plan", "request": long_plan(150, 3, seed=s)}).json()["id"]
+            for s in range(3)
+        ]
+        wait_for(first.url, pending[0], states=("running",))
+        workers = children(first.process.pid)
+        first.process.send_signal(signal.SIGKILL)
+        first.process.wait()
+        deadline = time.monotonic() + 8  # the workers notice their server is gone
+        while any(alive(pid) for pid in workers) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not any(alive(pid) for pid in workers)
+        second = Server(FAST, database_dir=Path(folder)).start()
+        try:
+            finished = [wait_for(second.url, job_id, timeout=90) for job_id in pending]
+            assert [job["status"] for job in finished] == ["succeeded"] * 3
+            assert finished[0]["attempts"] == 2  # the one that was running ran again
+            kept = httpx.get(f"{second.url}/v1/jobs/{done_before}").json()
+            assert kept["status"] == "succeeded" and kept["result"]["tour"][0] == "depot-simmering"
+        finally:
+            second.close()
+
+
+def test_finished_jobs_expire_after_the_retention():
+    short = Server(FAST | {"COLDROUTE_JOB_RETENTION_S": "1"}).start()
+    try:
+        job_id = submit(short.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+        wait_for(short.url, job_id)
+        deadline = time.monotonic() + 15
+        while httpx.get(f"{short.url}/v1/jobs/{job_id}").status_code != 404:
+            assert time.monotonic() < deadline
+            time.sleep(0.5)
+    finally:
+        short.close()

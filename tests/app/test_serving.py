@@ -1,0 +1,138 @@
+"""Serving that holds: the real server (python -m app.serve) in a subprocess, its worker pool
+saturated, its queue full, its shutdown."""
+
+from __future__ import annotations
+
+import concurrent.futures
+import signal
+import time
+
+import httpx
+import numpy as np
+import pytest
+
+from benchmarks.common import Server
+from tests.app.serving import alive, children, long_plan
+
+
+@pytest.fixture
+def server(request):
+    env = {"COLDROUTE_WORKERS": "2"} | getattr(request, "param", {})
+    started = Server(env).start()
+    yield started
+    started.close()
+
+
+def post(url: str, body: dict, timeout: float = 60) -> httpx.Response:
+    return httpx.post(f"{url}/v1/plans", json=body, timeout=timeout)
+
+
+def test_liveness_answers_while_every_worker_solves(server):
+    # Two 300-stop rounds of 6 s each keep both workers (both cores) busy.
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        solving = [pool.submit(post, server.url, long_plan(300, 6, seed=s)) for s in (1, 2)]
+        time.sleep(1.0)
+        latencies = []
+        while not all(f.done() for f in solving) and len(latencies) < 200:
+            started = time.perf_counter()
+            assert httpx.get(f"{server.url}/healthz", timeout=5).status_code == 200
+            latencies.append(time.perf_counter() - started)
+            time.sleep(0.02)
+        assert [f.result().status_code for f in solving] == [200, 200]
+    assert len(latencies) > 50
+    assert np.percentile(latencies, 99) < 0.1
+
+
+@pytest.mark.parametrize(
+    "server",
+    [{"COLDROUTE_WORKERS": "1", "COLDROUTE_QUEUE_SIZE": "1", "COLDROUTE_QUEUE_DEADLINE_S": "2"}],
+    indirect=True,
+)
+def test_a_full_queue_and_a_long_wait_are_503_with_retry_after(server):
+    with concurrent.futures.ThreadPoolExecutor(3) as pool:
+        busy = pool.submit(post, server.url, long_plan(300, 5))
+        time.sleep(1.0)
+        queued = pool.submit(post, server.url, long_plan(8, 0.1))
+        time.sleep(0.3)
+        started = time.perf_counter()
+        full = post(server.url, long_plan(8, 0.1))
+        assert time.perf_counter() - started < 1.0  # refused at once, not left hanging
+        assert full.status_code == 503 and "Retry-After" in full.headers
+        assert full.headers["content-type"] == "application/problem+json"
+        assert full.json()["service"] == "workers"
+        # the queued one waited past its 2 s deadline for the busy worker
+        late = queued.result()
+        assert late.status_code == 503 and int(late.headers["Retry-After"]) >= 1
+        assert busy.result().status_code == 200
+
+
+@pytest.mark.parametrize("server", [{"COLDROUTE_WORKERS": "1"}], indirect=True)
+def test_a_client_that_goes_away_gives_up_its_place(server):
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        busy = pool.submit(post, server.url, long_plan(300, 4))
+        time.sleep(1.0)
+        with pytest.raises(httpx.ReadTimeout):
+            post(server.url, long_plan(8, 0.1), timeout=0.5)
+        time.sleep(0.5)
+        workers = next(
+            c for c in httpx.get(f"{server.url}/readyz").json()["checks"] if c["name"] == "workers"
+        )
+        assert "0 waiting" in workers["detail"]
+        assert busy.result().status_code == 200
+
+
+@pytest.mark.parametrize("server", [{"COLDROUTE_WORKERS": "1"}], indirect=True)
+def test_readiness_names_what_is_down(server):
+    ready = httpx.get(f"{server.url}/readyz")
+    assert ready.status_code == 200 and ready.json()["status"] == "ready"
+    assert {c["name"] for c in ready.json()["checks"]} == {"workers", "database"}
+    # a configured router that is down makes the server unready, naming it
+    port = Server().port
+    broken = Server({"COLDROUTE_OSRM_URL": f"http://127.0.0.1:{port}"}).start()
+    try:
+        response = httpx.get(f"{broken.url}/readyz")
+        assert response.status_code == 503
+        osrm = next(c for c in response.json()["checks"] if c["name"] == "osrm")
+        assert not osrm["ok"] and osrm["critical"]
+    finally:
+        broken.close()
+
+
+@pytest.mark.parametrize("server", [{"COLDROUTE_WORKERS": "1"}], indirect=True)
+def test_sigterm_refuses_new_work_finishes_what_runs_and_exits_in_time(server):
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        running = pool.submit(post, server.url, long_plan(300, 3))
+        time.sleep(1.0)
+        waiting = pool.submit(post, server.url, long_plan(8, 0.1))
+        time.sleep(0.3)
+        signalled = time.monotonic()
+        server.process.send_signal(signal.SIGTERM)
+        time.sleep(0.3)
+        with pytest.raises(httpx.ConnectError):  # refused at once, not hanging
+            httpx.get(f"{server.url}/healthz", timeout=2)
+        assert waiting.result().status_code == 503
+        assert running.result().status_code == 200  # finished within the 8 s grace
+        server.process.wait(timeout=10)
+        assert time.monotonic() - signalled < 10
+
+
+@pytest.mark.parametrize(
+    "server", [{"COLDROUTE_WORKERS": "1", "COLDROUTE_SHUTDOWN_GRACE_S": "2"}], indirect=True
+)
+def test_sigterm_answers_503_to_what_outlasts_the_grace(server):
+    workers = children(server.process.pid)
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        running = pool.submit(post, server.url, long_plan(300, 8))
+        time.sleep(1.0)
+        signalled = time.monotonic()
+        server.process.send_signal(signal.SIGTERM)
+        late = running.result()
+        assert late.status_code == 503 and "shut down" in late.json()["detail"]
+        server.process.wait(timeout=10)
+        assert time.monotonic() - signalled < 2 + 3
+    # no orphaned solver left behind (a worker's watchdog notices its server is gone within a
+    # second of starting up)
+    deadline = time.monotonic() + 8
+    while any(alive(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert workers and not any(alive(pid) for pid in workers)
