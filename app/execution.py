@@ -29,7 +29,6 @@ from collections.abc import Awaitable, Callable
 from concurrent.futures import CancelledError as FutureCancelledError
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeoutError
-from functools import lru_cache
 from typing import Any, TypeVar
 
 from pebble import ProcessExpired, ProcessPool
@@ -82,15 +81,27 @@ def _ping() -> int:
     return os.getpid()
 
 
-@lru_cache(maxsize=4)
+_POOLS: dict[int, ProcessPool] = {}
+
+
 def worker_pool(workers: int) -> ProcessPool:
     """The process's pool of ``workers`` spawned processes (one per process and size)."""
-    return ProcessPool(
-        max_workers=workers,
-        context=multiprocessing.get_context("spawn"),
-        initializer=_initialize_worker,
-        initargs=(os.getpid(),),
-    )
+    if workers not in _POOLS:
+        _POOLS[workers] = ProcessPool(
+            max_workers=workers,
+            context=multiprocessing.get_context("spawn"),
+            initializer=_initialize_worker,
+            initargs=(os.getpid(),),
+        )
+    return _POOLS[workers]
+
+
+def stop_pools() -> None:
+    """Stop every worker pool of this process now (its threads would keep it alive)."""
+    while _POOLS:
+        _, pool = _POOLS.popitem()
+        pool.stop()  # type: ignore[no-untyped-call]
+        pool.join(timeout=0.5)
 
 
 class Executor:
@@ -228,6 +239,4 @@ class Executor:
         """Stop the workers now."""
         if not self._stopped:
             self._stopped = True
-            self.pool.stop()  # type: ignore[no-untyped-call]
-            self.pool.join(timeout=0.5)
-            worker_pool.cache_clear()
+            stop_pools()

@@ -100,6 +100,12 @@ class Settings(BaseSettings):
         description="Celery broker (redis://127.0.0.1:6379/0): jobs go to Celery workers "
         "(make worker) instead of the server's own pool. Needs a PostgreSQL database_url.",
     )
+    broker_queue: str = Field(
+        "coldroute",
+        min_length=1,
+        max_length=200,
+        description="Celery queue of the jobs: deployments that share a broker use their own.",
+    )
     job_slots: int | None = Field(
         None,
         ge=1,

@@ -36,13 +36,14 @@ def celery_for(settings: Settings) -> Celery:
     """The Celery app of the settings' broker."""
     if settings.broker_url is None:
         raise ValueError("COLDROUTE_BROKER_URL is not set: Celery needs a broker")
-    return _celery(settings.broker_url)
+    return _celery(settings.broker_url, settings.broker_queue)
 
 
 @lru_cache(maxsize=4)
-def _celery(broker_url: str) -> Celery:
+def _celery(broker_url: str, queue: str) -> Celery:
     app = Celery("coldroute", broker=broker_url)
     app.conf.update(
+        task_default_queue=queue,
         task_acks_late=True,
         task_reject_on_worker_lost=True,
         worker_prefetch_multiplier=1,

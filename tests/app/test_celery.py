@@ -36,6 +36,7 @@ def services():
         "COLDROUTE_DATABASE_URL": "postgresql+psycopg://postgres@127.0.0.1:5432/test"
         f"?options=-csearch_path%3D{schema}",
         "COLDROUTE_BROKER_URL": broker,
+        "COLDROUTE_BROKER_QUEUE": f"jobs-{schema}",
         "COLDROUTE_JOB_HEARTBEAT_S": "0.5",
         "COLDROUTE_JOB_STALE_AFTER_S": "3",
         "COLDROUTE_WORKERS": "1",

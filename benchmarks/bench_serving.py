@@ -1,0 +1,239 @@
+"""Serving: a 60 s mixed load over HTTP, liveness while two 500-stop jobs run, and jobs per
+second through the server's own pool and through Celery with two workers (loopback only)."""
+
+from __future__ import annotations
+
+import asyncio
+import copy
+import random
+import subprocess
+import sys
+import time
+import uuid
+
+import httpx
+import numpy as np
+import psycopg
+import redis
+
+from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
+from benchmarks.common import Server, print_table
+
+LOAD_S = 60.0
+CLIENTS = 8
+POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
+
+
+def plan_with(n_stops: int, time_limit_s: float = 1.0, seed: int | None = None) -> dict:
+    rng = np.random.default_rng(n_stops if seed is None else seed)
+    body = copy.deepcopy(PLAN_EXAMPLE)
+    body["stops"] = [
+        {
+            "id": f"S{i}",
+            "lat": 48.21 + rng.uniform(-0.05, 0.05),
+            "lon": 16.37 + rng.uniform(-0.08, 0.08),
+            "service_time_s": 240,
+            "door_open_s": 90,
+            "delivery_kg": 400 / n_stops,
+        }
+        for i in range(n_stops)
+    ]
+    body["time_limit_s"] = time_limit_s
+    return body
+
+
+KINDS = {
+    "plan, 8 stops": ("/v1/plans", plan_with(8)),
+    "plan, 50 stops": ("/v1/plans", plan_with(50)),
+    "simulate, 8 km urban leg": ("/v1/simulate", SIMULATE_EXAMPLE),
+}
+
+
+async def _load(url: str) -> dict[str, tuple[list[float], int]]:
+    done: dict[str, tuple[list[float], int]] = {kind: ([], 0) for kind in KINDS}
+    stop_at = time.monotonic() + LOAD_S
+    choices = random.Random(0)
+
+    async def client(http: httpx.AsyncClient) -> None:
+        while time.monotonic() < stop_at:
+            kind = choices.choice(list(KINDS))
+            path, body = KINDS[kind]
+            started = time.perf_counter()
+            response = await http.post(f"{url}{path}", json=body)
+            latencies, errors = done[kind]
+            latencies.append(time.perf_counter() - started)
+            done[kind] = (latencies, errors + (response.status_code != 200))
+
+    async with httpx.AsyncClient(timeout=120) as http:
+        await asyncio.gather(*(client(http) for _ in range(CLIENTS)))
+    return done
+
+
+def mixed_load() -> None:
+    server = Server({"COLDROUTE_WORKERS": "2"}).start()
+    try:
+        done = asyncio.run(_load(server.url))
+    finally:
+        server.close()
+    rows = []
+    for kind, (latencies, errors) in done.items():
+        ms = np.array(latencies) * 1000
+        rows.append(
+            [
+                kind,
+                len(latencies),
+                f"{np.percentile(ms, 50):.0f}",
+                f"{np.percentile(ms, 95):.0f}",
+                f"{np.percentile(ms, 99):.0f}",
+                errors,
+            ]
+        )
+    print_table(
+        f"Mixed load through the server ({LOAD_S:.0f} s, {CLIENTS} concurrent clients, "
+        "2 worker processes, 2 cores)",
+        ["kind", "requests", "p50 [ms]", "p95 [ms]", "p99 [ms]", "non-200"],
+        rows,
+    )
+
+
+def wait_all(url: str, ids: list[str], timeout_s: float = 600) -> list[dict]:
+    deadline = time.monotonic() + timeout_s
+    finished: dict[str, dict] = {}
+    with httpx.Client(timeout=30) as http:
+        while len(finished) < len(ids) and time.monotonic() < deadline:
+            for job_id in ids:
+                if job_id not in finished:
+                    job = http.get(f"{url}/v1/jobs/{job_id}").json()
+                    if job["status"] in ("succeeded", "failed", "cancelled"):
+                        finished[job_id] = job
+            time.sleep(0.1)
+    return list(finished.values())
+
+
+def liveness_under_jobs() -> None:
+    server = Server({"COLDROUTE_WORKERS": "2", "COLDROUTE_JOB_SLOTS": "2"}).start()
+    try:
+        ids = [
+            httpx.post(
+                f"{server.url}/v1/jobs",
+                json={"type": "plan", "request": plan_with(500, 10, seed=s)},
+                timeout=30,
+            ).json()["id"]
+            for s in (1, 2)
+        ]
+        latencies = []
+        with httpx.Client(timeout=10) as http:
+            while True:
+                started = time.perf_counter()
+                http.get(f"{server.url}/healthz")
+                latencies.append(time.perf_counter() - started)
+                statuses = [http.get(f"{server.url}/v1/jobs/{i}").json()["status"] for i in ids]
+                if all(s in ("succeeded", "failed") for s in statuses):
+                    break
+                time.sleep(0.05)
+    finally:
+        server.close()
+    ms = np.array(latencies) * 1000
+    print_table(
+        "GET /healthz while two 500-stop jobs (10 s solves) keep both workers busy",
+        ["probes", "p50 [ms]", "p99 [ms]", "max [ms]", "target p99"],
+        [
+            [
+                len(ms),
+                f"{np.percentile(ms, 50):.1f}",
+                f"{np.percentile(ms, 99):.1f}",
+                f"{ms.max():.1f}",
+                "< 100 ms",
+            ]
+        ],
+    )
+
+
+def _throughput(url: str, n_jobs: int) -> tuple[float, int]:
+    started = time.perf_counter()
+    with httpx.Client(timeout=30) as http:
+        ids = [
+            http.post(f"{url}/v1/jobs", json={"type": "plan", "request": plan_with(25)}).json()[
+                "id"
+            ]
+            for _ in range(n_jobs)
+        ]
+    jobs = wait_all(url, ids)
+    elapsed = time.perf_counter() - started
+    return len(jobs) / elapsed, n_jobs - sum(j["status"] == "succeeded" for j in jobs)
+
+
+def jobs_per_second(n_jobs: int = 40) -> None:
+    rows = []
+    local = Server({"COLDROUTE_WORKERS": "2", "COLDROUTE_JOB_SLOTS": "2"}).start()
+    try:
+        rate, failed = _throughput(local.url, n_jobs)
+        rows.append(["the server's own pool (2 processes)", n_jobs, f"{rate:.2f}", failed])
+    finally:
+        local.close()
+    schema = f"bench_{uuid.uuid4().hex[:8]}"
+    broker = "redis://127.0.0.1:6379/13"
+    redis.Redis.from_url(broker).flushdb()
+    with psycopg.connect(POSTGRES, autocommit=True) as connection:
+        connection.execute(f"CREATE SCHEMA {schema}")
+    env = {
+        "COLDROUTE_DATABASE_URL": "postgresql+psycopg://postgres@127.0.0.1:5432/test"
+        f"?options=-csearch_path%3D{schema}",
+        "COLDROUTE_BROKER_URL": broker,
+        "COLDROUTE_BROKER_QUEUE": f"jobs-{schema}",
+        "COLDROUTE_WORKERS": "1",
+    }
+    server = Server(env).start()
+    workers = [
+        subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "celery",
+                "-A",
+                "app.jobs.worker",
+                "worker",
+                "--pool=threads",
+                "--concurrency=1",
+                "--loglevel=WARNING",
+                "-n",
+                f"bench{i}@%h",
+            ],
+            env=server.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        for i in (1, 2)
+    ]
+    try:
+        time.sleep(5)  # the workers connect and warm their process
+        rate, failed = _throughput(server.url, n_jobs)
+        rows.append(
+            ["Celery, 2 workers × 1 process, PostgreSQL + Redis", n_jobs, f"{rate:.2f}", failed]
+        )
+    finally:
+        for worker in workers:
+            worker.terminate()
+        for worker in workers:
+            try:
+                worker.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                worker.kill()
+        server.close()
+        with psycopg.connect(POSTGRES, autocommit=True) as connection:
+            connection.execute(f"DROP SCHEMA {schema} CASCADE")
+    print_table(
+        "Jobs per second (25-stop plans, submitted at once, until all have succeeded)",
+        ["runner", "jobs", "jobs/s", "failed"],
+        rows,
+    )
+
+
+def main() -> None:
+    mixed_load()
+    liveness_under_jobs()
+    jobs_per_second()
+
+
+if __name__ == "__main__":
+    main()
