@@ -25,7 +25,15 @@ lint: $(STAMP)
 $(OSRM): | $(STAMP)
 	$(BIN)/python -m tools.osrm install
 
-test: lint $(OSRM)
+# Debian's Chromium for the browser tests of Swagger UI and ReDoc (Playwright drives it; no
+# browser download).
+CHROMIUM := /usr/bin/chromium
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+$(CHROMIUM):
+	$(SUDO) apt-get install -y --no-install-recommends chromium \
+		|| ($(SUDO) apt-get update && $(SUDO) apt-get install -y --no-install-recommends chromium)
+
+test: lint $(OSRM) $(CHROMIUM)
 	$(BIN)/python -m pytest
 
 bench: $(STAMP) $(OSRM)
@@ -46,7 +54,9 @@ serve: $(STAMP)
 worker: $(STAMP)
 	$(BIN)/celery -A app.jobs.worker worker --pool=threads --loglevel=INFO --concurrency=$${COLDROUTE_WORKERS:-$$(nproc)}
 
+# The Swagger answer examples (a real run), then the committed OpenAPI document.
 openapi: $(STAMP)
+	$(BIN)/python -m app.examples
 	$(BIN)/python -m app.openapi > openapi/openapi.json
 
 report: $(STAMP)

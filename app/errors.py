@@ -9,6 +9,7 @@ from typing import Any
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from sqlalchemy.exc import OperationalError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from app.execution import UnavailableError
@@ -44,7 +45,10 @@ def problem(
 def core_problem(error: CoreError) -> dict[str, Any]:
     """The 422 problem of a core error, naming its field."""
     title = "Limit exceeded" if isinstance(error, LimitExceededError) else "Invalid request"
-    errors = [{"field": error.field or "body", "message": error.message, "type": "value_error"}]
+    errors = [
+        {"field": field, "message": message, "type": "value_error"}
+        for field, message in error.details
+    ]
     return problem_body(422, title, error.message, errors=errors)
 
 
@@ -53,18 +57,33 @@ def service_problem(error: ServiceUnavailableError) -> dict[str, Any]:
     return problem_body(503, "Service unavailable", error.message, service=error.service)
 
 
-def _location(loc: tuple[Any, ...]) -> str:
-    """``("body", "stops", 3, "lat")`` → ``stops[3].lat``."""
+def _location(loc: tuple[Any, ...], kind: str = "") -> str:
+    """``("body", "stops", 3, "lat")`` → ``stops[3].lat``; a body that is not JSON → ``body``
+    (its location is the character where JSON broke, not a field)."""
+    if kind == "json_invalid":
+        return "body"
     path = ""
     for part in loc[1:] if loc and loc[0] == "body" else loc:
         path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
     return path or "body"
 
 
+def _message(error: Any) -> str:
+    if error["type"] == "json_invalid":
+        position = error["loc"][-1] if error["loc"] else "?"
+        reason = (error.get("ctx") or {}).get("error", "invalid JSON")
+        return f"the body is not valid JSON at character {position}: {reason}"
+    return str(error["msg"])
+
+
 async def _validation(_: Request, error: Exception) -> JSONResponse:
     assert isinstance(error, RequestValidationError)
     errors = [
-        {"field": _location(tuple(e["loc"])), "message": e["msg"], "type": e["type"]}
+        {
+            "field": _location(tuple(e["loc"]), e["type"]),
+            "message": _message(e),
+            "type": e["type"],
+        }
         for e in error.errors()
     ]
     detail = "; ".join(f"{e['field']}: {e['message']}" for e in errors[:5])
@@ -76,8 +95,18 @@ async def _core(_: Request, error: Exception) -> JSONResponse:
     return JSONResponse(core_problem(error), status_code=422, media_type=PROBLEM_JSON)
 
 
-async def _http(_: Request, error: Exception) -> JSONResponse:
+async def _http(request: Request, error: Exception) -> JSONResponse:
     assert isinstance(error, StarletteHTTPException)
+    if error.status_code == 405:
+        headers = dict(error.headers or {}) | {
+            # Every method documented at this path (Starlette names only the first route's).
+            "Allow": ", ".join(sorted(request.app.state.routes.methods(request.url.path)))
+        }
+        return problem(405, "Method not allowed", str(error.detail), headers=headers)
+    if error.status_code == 400:  # a body that cannot even be read is an invalid request
+        detail = f"the body cannot be read as JSON ({error.detail})"
+        errors = [{"field": "body", "message": detail, "type": "json_invalid"}]
+        return problem(422, "Invalid request", detail, errors=errors)
     titles = {
         401: "Unauthorized",
         404: "Not found",
@@ -113,9 +142,15 @@ async def _unavailable(_: Request, error: Exception) -> JSONResponse:
     )
 
 
-async def _unexpected(_: Request, error: Exception) -> JSONResponse:
-    _log.exception("unexpected error", exc_info=error)
-    return problem(500, "Internal error", "An unexpected error occurred; it has been logged.")
+async def _database(_: Request, error: Exception) -> JSONResponse:
+    _log.warning("database unavailable: %s", error)
+    return problem(
+        503,
+        "Service unavailable",
+        "the job database does not answer; try again shortly",
+        headers={"Retry-After": str(SERVICE_RETRY_AFTER_S)},
+        service="database",
+    )
 
 
 def install(app: FastAPI) -> None:
@@ -125,4 +160,5 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(ServiceUnavailableError, _service)
     app.add_exception_handler(UnavailableError, _unavailable)
     app.add_exception_handler(StarletteHTTPException, _http)
-    app.add_exception_handler(Exception, _unexpected)
+    app.add_exception_handler(OperationalError, _database)
+    # Anything else: app.main.RequestContext answers 500 and logs it once.

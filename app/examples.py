@@ -81,3 +81,57 @@ SCENARIOS_EXAMPLE: dict[str, Any] = {
     "driver_aggressiveness": [0.2, 0.5, 1.0],
     "traffic_density": [0.2, 0.8],
 }
+
+
+def record() -> dict[str, Any]:
+    """The answers of the examples above from a real run (``python -m app.examples`` writes
+    them to app/response_examples.json, which Swagger shows)."""
+    import datetime as dt
+
+    from app import work
+    from app.routers.results import plan_response
+    from app.schemas import (
+        JobOut,
+        PlanRequest,
+        ScenariosRequest,
+        SimulateRequest,
+        SpeedSweepRequest,
+    )
+    from app.settings import Settings
+
+    settings = Settings()
+    plan = plan_response(work.run_plan(PlanRequest.model_validate(PLAN_EXAMPLE), settings))
+    plan_json = plan.model_dump(mode="json")
+    accepted = dt.datetime(2026, 7, 14, 22, 0, 3, tzinfo=dt.UTC)
+    job = JobOut(
+        id="6f1c2a9e-4b7d-4e0a-9a51-2f7f3c1d8e20",
+        type="plan",
+        status="succeeded",
+        created_at=accepted,
+        started_at=accepted + dt.timedelta(seconds=0.4),
+        finished_at=accepted + dt.timedelta(seconds=0.5),
+        attempts=1,
+        result=plan,
+    )
+    return {
+        "plan": plan_json,
+        "simulate": work.simulate_trace(
+            SimulateRequest.model_validate(SIMULATE_EXAMPLE), settings
+        ).model_dump(mode="json"),
+        "speed_sweep": work.sweep_speeds(
+            SpeedSweepRequest.model_validate(SPEED_SWEEP_EXAMPLE), settings
+        ).model_dump(mode="json"),
+        "scenarios": work.run_scenarios(
+            ScenariosRequest.model_validate(SCENARIOS_EXAMPLE), settings
+        ).model_dump(mode="json"),
+        "job": job.model_dump(mode="json"),
+    }
+
+
+if __name__ == "__main__":
+    import json
+    from pathlib import Path
+
+    target = Path(__file__).with_name("response_examples.json")
+    target.write_text(json.dumps(record(), indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    print(f"wrote {target}")

@@ -5,27 +5,32 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import re
 import secrets
 import signal
 import threading
 import time
+import uuid
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
+from contextvars import ContextVar
 from importlib.metadata import version
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Depends, FastAPI, Header, HTTPException
+from fastapi import APIRouter, Depends, FastAPI, HTTPException, Request, Response
 from fastapi.middleware.cors import CORSMiddleware
-from pydantic import BaseModel
-from pydantic.json_schema import models_json_schema
+from fastapi_offline import FastAPIOffline
+from prometheus_client import CONTENT_TYPE_LATEST, generate_latest
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from app import errors
+from app import errors, openapi_doc
 from app.execution import Executor
 from app.jobs.runner import CeleryDispatcher, LocalRunner
 from app.jobs.store import store_for
+from app.metrics import Metrics
 from app.routers import health, jobs, plans, presets, simulate, studies
-from app.schemas import PlanFeatureCollection, Problem
+from app.routes import RouteTemplates
+from app.schemas import PlanFeatureCollection
 from app.settings import Settings, get_settings
 
 _log = logging.getLogger("coldroute.requests")
@@ -90,54 +95,135 @@ class BodyLimit:
         await send({"type": "http.response.body", "body": body})
 
 
-class RequestLog:
-    """One structured (JSON) log line per request: method, path, status, duration."""
+#: The id of the request being served (for the log lines written while serving it).
+REQUEST_ID: ContextVar[str] = ContextVar("coldroute_request_id", default="-")
+_REQUEST_ID_PATTERN = re.compile(r"^[A-Za-z0-9._:-]{1,128}$")
 
-    def __init__(self, app: ASGIApp) -> None:
+
+class RequestContext:
+    """Per request: an ``X-Request-ID`` (the client's, if it is a sane token, else a new
+    one) returned in the answer; one structured (JSON) log line (method, path, route, status,
+    duration, request id); the request metrics; and a last safety net: an unexpected error is
+    a 500 problem with ``Connection: close`` and one logged traceback carrying the request
+    id, never a dropped connection."""
+
+    def __init__(self, app: ASGIApp, metrics: Metrics, routes: RouteTemplates) -> None:
         self.app = app
+        self.metrics = metrics
+        self.routes = routes
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
         started = time.perf_counter()
+        sent = dict(scope["headers"]).get(b"x-request-id", b"").decode("latin-1")
+        request_id = sent if _REQUEST_ID_PATTERN.match(sent) else uuid.uuid4().hex
+        token = REQUEST_ID.set(request_id)
         status = 500
+        answered = False
 
-        async def recording_send(message: Message) -> None:
-            nonlocal status
+        async def tagged_send(message: Message) -> None:
+            nonlocal status, answered
             if message["type"] == "http.response.start":
                 status = message["status"]
+                answered = True
+                message["headers"] = [
+                    *message.get("headers", []),
+                    (b"x-request-id", request_id.encode()),
+                ]
             await send(message)
 
         try:
-            await self.app(scope, receive, recording_send)
+            await self.app(scope, receive, tagged_send)
+        except Exception:
+            _log.exception(json.dumps({"error": "unexpected", "request_id": request_id}))
+            if not answered:
+                body = json.dumps(
+                    errors.problem_body(
+                        500,
+                        "Internal error",
+                        f"An unexpected error occurred; it has been logged as {request_id}.",
+                        request_id=request_id,
+                    )
+                ).encode()
+                await tagged_send(
+                    {
+                        "type": "http.response.start",
+                        "status": 500,
+                        "headers": [
+                            (b"content-type", errors.PROBLEM_JSON.encode()),
+                            (b"content-length", str(len(body)).encode()),
+                            (b"connection", b"close"),
+                        ],
+                    }
+                )
+                await send({"type": "http.response.body", "body": body})
         finally:
+            route = scope.get("route")
+            template = (
+                self.routes.template(scope["path"]) or getattr(route, "path", None) or "unmatched"
+            )
+            seconds = time.perf_counter() - started
+            self.metrics.observe(scope["method"], template, status, seconds)
             _log.info(
                 json.dumps(
                     {
                         "method": scope["method"],
                         "path": scope["path"],
+                        "route": template,
                         "status": status,
-                        "duration_ms": round((time.perf_counter() - started) * 1000, 1),
+                        "duration_ms": round(seconds * 1000, 1),
+                        "request_id": request_id,
                     }
                 )
             )
+            REQUEST_ID.reset(token)
 
 
-def require_api_key(
-    settings: Annotated[Settings, Depends(get_settings)],
-    x_api_key: Annotated[
-        str | None, Header(description="Needed when the server sets a key.")
-    ] = None,
-) -> None:
-    """401 unless the request carries the configured key (no key configured: open)."""
+def require_api_key(settings: Annotated[Settings, Depends(get_settings)], request: Request) -> None:
+    """401 unless the request carries the configured key (no key configured: open). The key
+    is a security scheme in the OpenAPI document (app.openapi_doc), not a parameter."""
     if settings.api_key is None:
         return
-    expected = settings.api_key.get_secret_value()
-    if x_api_key is None or not secrets.compare_digest(x_api_key, expected):
+    x_api_key = request.headers.get("x-api-key")
+    expected = settings.api_key.get_secret_value().encode()
+    # Bytes: compare_digest refuses non-ASCII text, and any key a client sends is just wrong.
+    if x_api_key is None or not secrets.compare_digest(x_api_key.encode(), expected):
         raise HTTPException(
             401, "missing or wrong X-API-Key", headers={"WWW-Authenticate": "ApiKey"}
         )
+
+
+DOCS_PATHS = frozenset({"/docs", "/redoc"})
+# The docs pages may load only what the service itself serves: ReDoc's attribution logo would
+# otherwise be fetched from a CDN, which a dispatcher's offline network cannot reach.
+DOCS_POLICY = (
+    b"default-src 'self'; script-src 'self' 'unsafe-inline'; style-src 'self' 'unsafe-inline'; "
+    b"img-src 'self' data:; font-src 'self' data:; worker-src 'self' blob:; connect-src 'self'"
+)
+
+
+class DocsPolicy:
+    """A ``Content-Security-Policy`` on the Swagger UI and ReDoc pages: same origin only."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http" or scope["path"] not in DOCS_PATHS:
+            await self.app(scope, receive, send)
+            return
+
+        async def with_policy(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                message["headers"] = [
+                    *message.get("headers", []),
+                    (b"content-security-policy", DOCS_POLICY),
+                ]
+            await send(message)
+
+        await self.app(scope, receive, with_policy)
 
 
 class Draining:
@@ -224,35 +310,38 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     logging.basicConfig(level=settings.log_level.upper(), format="%(message)s")
     # One line per request is ours to write; the router and weather calls are not news.
     logging.getLogger("httpx").setLevel(logging.WARNING)
-    app = FastAPI(
+    # Swagger UI and ReDoc from the service itself (fastapi-offline's pinned assets): the docs
+    # work without internet.
+    app = FastAPIOffline(
         title="coldroute",
         version=version("coldroute"),
         description=DESCRIPTION,
         lifespan=_lifespan,
-        responses={
-            status: {
-                "model": Problem,
-                "description": description,
-                "content": {errors.PROBLEM_JSON: {}},
-            }
-            for status, description in (
-                (400, "Unreadable body"),
-                (401, "Missing or wrong X-API-Key"),
-                (413, "Request body too large"),
-                (422, "Invalid request, fields named"),
-            )
-        },
+        swagger_ui_parameters={"persistAuthorization": True, "displayRequestDuration": True},
     )
     app.dependency_overrides[get_settings] = lambda: settings
     app.state.settings = settings
-    app.state.executor = Executor(settings)
+    executor = Executor(settings)
+    app.state.executor = executor
     app.state.runner = None
+    metrics = Metrics()
+    metrics.watch(
+        lambda: executor.waiting,
+        lambda: executor.running,
+        lambda: store_for(settings.database_url).counts(),
+    )
+    app.state.metrics = metrics
     errors.install(app)
     v1 = APIRouter(prefix="/v1", dependencies=[Depends(require_api_key)])
     for module in (plans, simulate, presets, studies, jobs):
         v1.include_router(module.router)
     app.include_router(v1)
     app.include_router(health.router)
+
+    @app.get("/metrics", include_in_schema=False)
+    def prometheus() -> Response:
+        return Response(generate_latest(metrics.registry), media_type=CONTENT_TYPE_LATEST)
+
     if settings.cors_origins:
         app.add_middleware(
             CORSMiddleware,
@@ -261,29 +350,19 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             allow_headers=["*"],
         )
     app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
-    app.add_middleware(Draining, executor=app.state.executor)
-    app.add_middleware(RequestLog)
-    _add_response_schemas(app, [PlanFeatureCollection])
-    return app
-
-
-def _add_response_schemas(app: FastAPI, models: list[type[BaseModel]]) -> None:
-    """Put models that operations reference by ``$ref`` only (alternative media types) into
-    the OpenAPI components."""
+    app.add_middleware(DocsPolicy)
+    app.add_middleware(Draining, executor=executor)
+    app.state.routes = RouteTemplates(app)
+    app.add_middleware(RequestContext, metrics=metrics, routes=app.state.routes)
     generate = app.openapi
 
     def openapi() -> dict[str, Any]:
         if app.openapi_schema is None:
-            schema = generate()
-            _, definitions = models_json_schema(
-                [(model, "serialization") for model in models],
-                ref_template="#/components/schemas/{model}",
-            )
-            schema["components"]["schemas"].update(definitions.get("$defs", {}))
-            app.openapi_schema = schema
+            app.openapi_schema = openapi_doc.finish(generate(), [PlanFeatureCollection])
         return app.openapi_schema
 
     app.openapi = openapi  # type: ignore[method-assign]
+    return app
 
 
 app = create_app()

@@ -3,17 +3,20 @@
 from __future__ import annotations
 
 import datetime as dt
-from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, Self
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, Self, get_args
 
 from pydantic import (
     AwareDatetime,
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Field,
     ModelWrapValidatorHandler,
+    ValidationError,
     create_model,
     model_validator,
 )
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from core.exceptions import InvalidParameterError
 from core.params import (
@@ -24,6 +27,8 @@ from core.params import (
     Depot,
     DoorOpening,
     Interval,
+    IsoDate,
+    IsoDateTime,
     Location,
     Objective,
     Params,
@@ -54,7 +59,7 @@ def clock_time(text: str) -> dt.time:
 class ApiModel(BaseModel):
     """Base of the API's own models: no unknown fields, no NaN or infinity."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
 
     @model_validator(mode="wrap")
     @classmethod
@@ -64,11 +69,47 @@ class ApiModel(BaseModel):
             return handler(data)
 
 
+def _refuse_null(value: Any) -> Any:
+    if value is None:
+        raise ValueError("null is not allowed here; leave the field out to keep the default")
+    return value
+
+
+def _schema_without_null(schema: dict[str, Any]) -> None:
+    """The JSON schema of an optional field that may be absent but not null."""
+    variants = schema.pop("anyOf", None)
+    if variants is not None:
+        kept = [v for v in variants if v.get("type") != "null"]
+        if len(kept) == 1:
+            schema.update(kept[0])
+        else:
+            schema["anyOf"] = kept
+    schema.pop("default", None)
+
+
+#: On a ``T | None`` field: it may be left out (None in Python) but, when given, is not null —
+#: as its schema (:func:`absent`) says.
+NotNull = BeforeValidator(_refuse_null)
+
+
+def absent_or(annotation: Any) -> Any:
+    """``Annotated[T | None, NotNull]`` for a type built at run time."""
+    return Annotated[Optional[annotation], NotNull]  # noqa: UP045 (a run-time type)
+
+
+def absent(description: str, **constraints: Any) -> Any:
+    """The Field of an :func:`absent_or` field."""
+    return Field(
+        None, description=description, json_schema_extra=_schema_without_null, **constraints
+    )
+
+
 def _overrides(name: str, params: type[Params], doc: str, **extra: Any) -> type[ApiModel]:
     """A model with every field of ``params`` optional: the values to change in a preset.
 
     Each field keeps the core's type, bounds and description, so Swagger shows exactly the
-    parameter the core uses.
+    parameter the core uses. Absent means the preset's value; null is allowed only where the
+    core's parameter itself may be null (``max_regen_power_w``: no cap), and means that.
     """
     fields: dict[str, Any] = dict(extra)
     for field_name, info in params.model_fields.items():
@@ -76,14 +117,12 @@ def _overrides(name: str, params: type[Params], doc: str, **extra: Any) -> type[
         annotation: Any = (
             Annotated[(info.annotation, *info.metadata)] if info.metadata else info.annotation
         )
-        fields[field_name] = (
-            Optional[annotation],  # noqa: UP045 (a run-time type, not an annotation)
-            Field(
-                None,
-                description=f"{info.description} Preset value if absent "
-                f"(paper-generic: {default}).",
-            ),
-        )
+        description = f"{info.description} Preset value if absent (paper-generic: {default})."
+        nullable = type(None) in get_args(info.annotation)
+        if nullable:
+            fields[field_name] = (annotation, Field(None, description=description))
+        else:
+            fields[field_name] = (absent_or(annotation), absent(description))
     return create_model(name, __base__=ApiModel, __doc__=doc, **fields)
 
 
@@ -96,7 +135,15 @@ else:
         "VehicleRequest",
         VehicleParams,
         "The van: a preset and any parameter to change in it.",
-        preset=(str, Field(DEFAULT_PRESET, description="Preset name (GET /v1/presets).")),
+        preset=(
+            str,
+            Field(
+                DEFAULT_PRESET,
+                min_length=1,
+                max_length=64,
+                description="Preset name (GET /v1/presets).",
+            ),
+        ),
     )
     CargoBoxRequest = _overrides(
         "CargoBoxRequest",
@@ -109,16 +156,23 @@ else:
 class VanRequest(ApiModel):
     """The parts of a request that describe the van (shared by plans, simulation, studies)."""
 
-    vehicle: VehicleRequest = Field(default_factory=VehicleRequest)
-    cargo_box: CargoBoxRequest = Field(default_factory=CargoBoxRequest)
-    battery: BatteryRequest = Field(default_factory=BatteryRequest)
-    payload_kg: float | None = Field(
-        None, ge=0, le=40_000, description="Payload at departure [kg]; preset value if absent."
+    vehicle: VehicleRequest = Field(
+        default_factory=VehicleRequest,
+        description="The van: a preset (vehicle.preset) and any vehicle parameter to change.",
     )
-    precondition_at_depot: bool | None = Field(
-        None,
-        description=f"{VanParams.model_fields['precondition_at_depot'].description} Preset "
-        "value if absent.",
+    cargo_box: CargoBoxRequest = Field(
+        default_factory=CargoBoxRequest,
+        description="Cargo box and refrigeration unit: the parameters to change in the preset.",
+    )
+    battery: BatteryRequest = Field(
+        default_factory=BatteryRequest,
+        description="Battery: the parameters to change in the preset.",
+    )
+    payload_kg: Annotated[Annotated[float, Field(ge=0, le=40_000)] | None, NotNull] = absent(
+        "Payload at departure [kg]; preset value if absent."
+    )
+    precondition_at_depot: Annotated[bool | None, NotNull] = absent(
+        f"{VanParams.model_fields['precondition_at_depot'].description} Preset value if absent."
     )
 
     def van(self) -> VanParams:
@@ -131,15 +185,20 @@ class VanRequest(ApiModel):
             "battery": (BatteryParams, preset.battery),
         }
         built: dict[str, Any] = {}
+        details: list[tuple[str, str]] = []
         for section, (model, base) in sections.items():
             changes: ApiModel = getattr(self, section)
             wanted = {k: getattr(changes, k) for k in changes.model_fields_set if k != "preset"}
             try:
-                built[section] = model(**(base.model_dump() | wanted))
-            except InvalidParameterError as error:
-                message = error.message.replace(model.__name__, section, 1)
-                field = f"{section}.{error.field}" if error.field else section
-                raise InvalidParameterError(message, field) from None
+                with inside_validation():  # pydantic's own errors, one per field
+                    built[section] = model(**(base.model_dump() | wanted))
+            except ValidationError as error:
+                for item in error.errors():
+                    path = ".".join(str(p) for p in item["loc"])
+                    details.append((f"{section}.{path}" if path else section, item["msg"]))
+        if details:
+            message = "; ".join(f"{field}: {rule}" for field, rule in details)
+            raise InvalidParameterError(message, details[0][0], details)
         payload = preset.payload_kg if self.payload_kg is None else self.payload_kg
         precondition = (
             preset.precondition_at_depot
@@ -152,7 +211,7 @@ class VanRequest(ApiModel):
 class PlanRequest(VanRequest):
     """A delivery round to plan: depot, stops, date, van and conditions."""
 
-    date: dt.date = Field(..., description="Day of the round, YYYY-MM-DD.")
+    date: IsoDate = Field(..., description="Day of the round, YYYY-MM-DD.")
     start_time: str = Field("08:00", pattern=HHMM_PATTERN, description="Departure, local HH:MM.")
     timezone: str | None = Field(
         None,
@@ -198,16 +257,16 @@ class EnergyKwh(ApiModel):
 class EnergyShare(ApiModel):
     """Each consumer's share of the total energy [–]."""
 
-    traction: float
-    auxiliaries: float
-    cabin: float
-    refrigeration: float
+    traction: float = Field(..., description="Drive train's share of the total [–].")
+    auxiliaries: float = Field(..., description="Auxiliaries' share of the total [–].")
+    cabin: float = Field(..., description="Cab HVAC's share of the total [–].")
+    refrigeration: float = Field(..., description="Refrigeration unit's share of the total [–].")
 
 
 class LineString(ApiModel):
     """A GeoJSON LineString (RFC 7946): positions as [longitude, latitude]."""
 
-    type: Literal["LineString"] = "LineString"
+    type: Literal["LineString"] = Field("LineString", description="Always LineString.")
     coordinates: list[tuple[float, float]] = Field(
         ..., description="Positions [lon, lat] in degrees (WGS 84)."
     )
@@ -216,22 +275,28 @@ class LineString(ApiModel):
 class Point(ApiModel):
     """A GeoJSON Point (RFC 7946)."""
 
-    type: Literal["Point"] = "Point"
+    type: Literal["Point"] = Field("Point", description="Always Point.")
     coordinates: tuple[float, float] = Field(..., description="[lon, lat] in degrees (WGS 84).")
 
 
 class LegOut(ApiModel):
     """One driven leg."""
 
-    from_id: str
-    to_id: str
+    from_id: str = Field(..., description="Where the leg starts: the depot's or a stop's id.")
+    to_id: str = Field(..., description="Where the leg ends: a stop's or the depot's id.")
     depart: dt.datetime = Field(..., description="Departure, local time with offset.")
     arrive: dt.datetime = Field(..., description="Arrival, local time with offset.")
     distance_m: float = Field(..., description="Distance [m].")
     duration_s: float = Field(..., description="Driving time [s].")
-    street_type: StreetTypeName
+    street_type: StreetTypeName = Field(
+        ...,
+        description="urban, highway or expressway: by the leg's speeds (router or client) "
+        "or its length (estimate).",
+    )
     grade: float = Field(..., description="Mean grade, rise over run [–].")
-    energy_kwh: EnergyKwh
+    energy_kwh: EnergyKwh = Field(
+        ..., description="Energy of each consumer while driving this leg [kWh]."
+    )
     soc_start: float = Field(..., description="State of charge at departure [–].")
     soc_end: float = Field(..., description="State of charge on arrival [–].")
     geometry: LineString | None = Field(
@@ -242,14 +307,16 @@ class LegOut(ApiModel):
 class StopOut(ApiModel):
     """One stop, in visiting order."""
 
-    id: str
-    arrival: dt.datetime
-    departure: dt.datetime
+    id: str = Field(..., description="The stop's id.")
+    arrival: dt.datetime = Field(..., description="Arrival, local time with UTC offset.")
+    departure: dt.datetime = Field(
+        ..., description="Departure after the service, local time with UTC offset."
+    )
     door_heat_kwh: float = Field(..., description="Heat let in through the open door [kWh].")
     payload_after_kg: float = Field(..., description="Payload when leaving the stop [kg].")
     energy_kwh: EnergyKwh = Field(..., description="Energy used while standing here [kWh].")
-    soc_arrival: float
-    soc_departure: float
+    soc_arrival: float = Field(..., description="State of charge on arrival [–].")
+    soc_departure: float = Field(..., description="State of charge when leaving [–].")
     snap_distance_m: float | None = Field(
         None,
         description="Distance from the stop to the road the router snapped it to [m]; null "
@@ -260,10 +327,12 @@ class StopOut(ApiModel):
 class Totals(ApiModel):
     """The whole round."""
 
-    distance_m: float
+    distance_m: float = Field(..., description="Distance of the round [m].")
     duration_s: float = Field(..., description="From departure to return, stops included [s].")
-    energy_kwh: EnergyKwh
-    energy_share: EnergyShare
+    energy_kwh: EnergyKwh = Field(..., description="Energy of each consumer over the round [kWh].")
+    energy_share: EnergyShare = Field(
+        ..., description="Each consumer's share of the round's energy [–]."
+    )
     grid_kwh: float = Field(
         0.0,
         description="Energy from the grid before departure to pre-condition cab and box [kWh] "
@@ -274,7 +343,9 @@ class Totals(ApiModel):
 class BatteryOut(ApiModel):
     """Whether the battery holds out with its reserve."""
 
-    feasible: bool
+    feasible: bool = Field(
+        ..., description="True when the state of charge never falls below the reserve (min_soc)."
+    )
     min_soc: float = Field(..., description="Lowest state of charge [–].")
     final_soc: float = Field(..., description="State of charge at the end [–].")
     margin_kwh: float = Field(..., description="Energy above the reserve at the lowest point.")
@@ -301,7 +372,7 @@ class BatteryOut(ApiModel):
 class DayWeatherOut(ApiModel):
     """One local day's temperatures."""
 
-    date: dt.date
+    date: dt.date = Field(..., description="The local day.")
     t_min_c: float = Field(..., description="Lowest temperature of the day's moments [°C].")
     t_max_c: float = Field(..., description="Highest temperature of the day's moments [°C].")
 
@@ -324,31 +395,43 @@ class WeatherOut(ApiModel):
 class BoxOut(ApiModel):
     """Cargo-box temperatures (dynamic mode; null in steady mode)."""
 
-    max_temperature_c: float | None
-    minutes_above_product_limit: float | None
+    max_temperature_c: float | None = Field(
+        ..., description="Highest cargo-air temperature [°C] (dynamic box; null in steady mode)."
+    )
+    minutes_above_product_limit: float | None = Field(
+        ...,
+        description="Time with the cargo air above the product limit [min] (dynamic box; "
+        "null in steady mode).",
+    )
 
 
 class SolverOut(ApiModel):
     """How the tour search ended."""
 
-    status: SolverStatus
-    objective: Objective
+    status: SolverStatus = Field(
+        ...,
+        description="optimal (proven over all arcs), feasible (the best found in the time "
+        "limit) or fixed_order (keep_order).",
+    )
+    objective: Objective = Field(
+        ..., description="What the tour minimised: distance, duration or energy."
+    )
     objective_value: float = Field(..., description="Of the tour, in m, s or Wh (estimate).")
-    runtime_s: float
+    runtime_s: float = Field(..., description="Time the tour search took [s].")
 
 
 class PlanResponse(ApiModel):
     """The planned and simulated round."""
 
     tour: list[str] = Field(..., description="Ids in driving order, depot first and last.")
-    legs: list[LegOut]
-    stops: list[StopOut]
-    totals: Totals
-    battery: BatteryOut
-    weather: WeatherOut
+    legs: list[LegOut] = Field(..., description="The driven legs, in order.")
+    stops: list[StopOut] = Field(..., description="The stops, in visiting order.")
+    totals: Totals = Field(..., description="The whole round.")
+    battery: BatteryOut = Field(..., description="Whether the battery holds out with its reserve.")
+    weather: WeatherOut = Field(..., description="The weather the round was simulated with.")
     timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
-    box: BoxOut
-    solver: SolverOut
+    box: BoxOut = Field(..., description="Cargo-box temperatures (dynamic mode).")
+    solver: SolverOut = Field(..., description="How the tour search ended.")
     distance_source: Literal["osrm", "client", "estimate"] = Field(
         ...,
         description="Where the legs' distances and durations came from: the OSRM router, the "
@@ -367,8 +450,10 @@ class PlanResponse(ApiModel):
 class Feature(ApiModel):
     """A GeoJSON Feature (RFC 7946)."""
 
-    type: Literal["Feature"] = "Feature"
-    geometry: Point | LineString
+    type: Literal["Feature"] = Field("Feature", description="Always Feature.")
+    geometry: Point | LineString = Field(
+        ..., description="A stop's Point or a leg's LineString, [lon, lat]."
+    )
     properties: dict[str, Any] = Field(..., description="What the feature is, with its figures.")
 
 
@@ -377,8 +462,12 @@ class PlanFeatureCollection(ApiModel):
     door heat, state of charge), the legs as LineStrings (energy per consumer, state of charge
     at both ends)."""
 
-    type: Literal["FeatureCollection"] = "FeatureCollection"
-    features: list[Feature]
+    type: Literal["FeatureCollection"] = Field(
+        "FeatureCollection", description="Always FeatureCollection."
+    )
+    features: list[Feature] = Field(
+        ..., description="The depot and the stops (Points), then the legs (LineStrings)."
+    )
     attribution: str | None = Field(None, description="Credit for the map data.")
 
 
@@ -394,15 +483,21 @@ class CycleRequest(ApiModel):
 class SimulateRequest(VanRequest):
     """One trace: either ``speed_mps`` with ``dt_s`` or a ``cycle`` to generate."""
 
-    speed_mps: list[float] | None = Field(
-        None, description="Speed samples [m/s], 0–69.4, every dt_s seconds."
+    model_config = ConfigDict(
+        json_schema_extra={"oneOf": [{"required": ["speed_mps"]}, {"required": ["cycle"]}]}
+    )
+
+    speed_mps: Annotated[Annotated[list[float], Field(min_length=2)] | None, NotNull] = absent(
+        "Speed samples [m/s], 0–69.4, every dt_s seconds, at least 2; give this or cycle."
     )
     dt_s: float = Field(1.0, ge=0.01, le=3600, description="Sampling interval [s].")
     grade: float | list[float] = Field(
         0.0, description="Road grade [–], one number or one per sample, within ±0.5."
     )
-    cycle: CycleRequest | None = Field(None, description="Generate the trace instead.")
-    start: AwareDatetime = Field(..., description="Start time, ISO 8601 with UTC offset.")
+    cycle: Annotated[CycleRequest | None, NotNull] = absent(
+        "Generate the trace from a street type instead; give this or speed_mps."
+    )
+    start: IsoDateTime = Field(..., description="Start time, ISO 8601 with UTC offset.")
     location: Location = Field(..., description="Where the van drives (sun, climatology).")
     weather: Weather | None = Field(
         None,
@@ -422,7 +517,12 @@ class SimulateRequest(VanRequest):
     @model_validator(mode="after")
     def _one_trace(self) -> Self:
         if (self.speed_mps is None) == (self.cycle is None):
-            raise ValueError("give exactly one of speed_mps and cycle")
+            # Named on a field: cycle when both came, speed_mps when neither did.
+            field = "cycle" if self.cycle is not None else "speed_mps"
+            rule = PydanticCustomError("one_of", "give exactly one of speed_mps and cycle")
+            raise ValidationError.from_exception_data(
+                type(self).__name__, [InitErrorDetails(type=rule, loc=(field,), input=None)]
+            )
         return self
 
 
@@ -438,7 +538,7 @@ class SpeedSweepRequest(VanRequest):
     distance_m: float = Field(
         20_000.0, ge=100, le=500_000, description="Trip length [m], at least 100 m."
     )
-    date: dt.date = Field(..., description="Day of the trips.")
+    date: IsoDate = Field(..., description="Day of the trips, YYYY-MM-DD.")
     start_time: str = Field("12:00", pattern=HHMM_PATTERN, description="Departure, local HH:MM.")
     timezone: str | None = Field(
         None, max_length=64, description="IANA time zone; absent: local mean solar time."
@@ -456,15 +556,21 @@ class SpeedSweepRequest(VanRequest):
 class SpeedPointOut(ApiModel):
     """One speed of the sweep."""
 
-    speed_kmh: float
-    energy_wh_per_km: ConsumptionWhPerKm
+    speed_kmh: float = Field(..., description="The trip's mean speed [km/h].")
+    energy_wh_per_km: ConsumptionWhPerKm = Field(
+        ..., description="Energy per km of each consumer at that speed [Wh/km]."
+    )
 
 
 class SpeedSweepResponse(ApiModel):
     """Energy per km at each speed, and the speed with the lowest total."""
 
-    points: list[SpeedPointOut]
-    optimum_speed_kmh: float
+    points: list[SpeedPointOut] = Field(
+        ..., description="One point per requested speed, in request order."
+    )
+    optimum_speed_kmh: float = Field(
+        ..., description="The speed with the lowest total energy per km [km/h]."
+    )
 
 
 class ScenariosRequest(ApiModel):
@@ -494,10 +600,12 @@ class ScenariosRequest(ApiModel):
 class ScenarioCellOut(ApiModel):
     """One cell of the grid."""
 
-    season: str
-    driver_aggressiveness: float
-    traffic_density: float | None
-    energy_kwh: EnergyKwh
+    season: str = Field(..., description="The season's name.")
+    driver_aggressiveness: float = Field(..., description="ε_d of the cell [–].")
+    traffic_density: float | None = Field(
+        ..., description="ε_t of the cell [–]; null: each street type's default."
+    )
+    energy_kwh: EnergyKwh = Field(..., description="Energy of each consumer in this cell [kWh].")
     change_vs_baseline_pct: float = Field(..., description="Total energy against the baseline.")
     feasible: bool = Field(..., description="The battery holds out with its reserve.")
 
@@ -505,50 +613,60 @@ class ScenarioCellOut(ApiModel):
 class ScenariosResponse(ApiModel):
     """The grid, one row per cell, on the baseline's tour."""
 
-    tour: list[str]
-    baseline_energy_kwh: EnergyKwh
-    cells: list[ScenarioCellOut]
+    tour: list[str] = Field(
+        ..., description="The baseline's tour, driven in every cell: ids, depot first and last."
+    )
+    baseline_energy_kwh: EnergyKwh = Field(
+        ..., description="Energy of the round in its own conditions [kWh]."
+    )
+    cells: list[ScenarioCellOut] = Field(
+        ..., description="One row per season × driver × traffic combination."
+    )
 
 
 class PowerSeries(ApiModel):
     """Mean power of each consumer over the step ending at each sample [W] (0 at the start)."""
 
-    traction: list[float]
-    auxiliaries: list[float]
-    cabin: list[float]
-    refrigeration: list[float]
+    traction: list[float] = Field(..., description="Drive-train power [W].")
+    auxiliaries: list[float] = Field(..., description="Auxiliaries' power [W].")
+    cabin: list[float] = Field(..., description="Cab HVAC power [W].")
+    refrigeration: list[float] = Field(..., description="Refrigeration unit's power [W].")
 
 
 class Series(ApiModel):
     """Time series at the trace's samples."""
 
-    time_s: list[float]
-    speed_mps: list[float]
-    power_w: PowerSeries
-    soc: list[float]
+    time_s: list[float] = Field(..., description="Seconds since the start [s].")
+    speed_mps: list[float] = Field(..., description="Speed at each sample [m/s].")
+    power_w: PowerSeries = Field(
+        ..., description="Each consumer's mean power over the step ending at each sample [W]."
+    )
+    soc: list[float] = Field(..., description="State of charge at each sample [–].")
 
 
 class ConsumptionWhPerKm(ApiModel):
     """Energy per distance [Wh/km]; null for a trace that moves less than a metre."""
 
-    traction: float | None
-    auxiliaries: float | None
-    cabin: float | None
-    refrigeration: float | None
-    total: float | None
+    traction: float | None = Field(..., description="Drive train [Wh/km].")
+    auxiliaries: float | None = Field(..., description="Auxiliaries [Wh/km].")
+    cabin: float | None = Field(..., description="Cab HVAC [Wh/km].")
+    refrigeration: float | None = Field(..., description="Refrigeration unit [Wh/km].")
+    total: float | None = Field(..., description="All consumers [Wh/km].")
 
 
 class SimulateResponse(ApiModel):
     """Energy of one trace."""
 
-    distance_m: float
-    duration_s: float
-    energy_kwh: EnergyKwh
-    consumption_wh_per_km: ConsumptionWhPerKm
-    battery: BatteryOut
-    weather: WeatherOut
-    box: BoxOut
-    series: Series | None = None
+    distance_m: float = Field(..., description="Distance of the trace [m].")
+    duration_s: float = Field(..., description="Duration of the trace [s].")
+    energy_kwh: EnergyKwh = Field(..., description="Energy of each consumer [kWh].")
+    consumption_wh_per_km: ConsumptionWhPerKm = Field(
+        ..., description="Energy per km of each consumer [Wh/km]."
+    )
+    battery: BatteryOut = Field(..., description="Whether the battery holds out with its reserve.")
+    weather: WeatherOut = Field(..., description="The weather the trace was simulated with.")
+    box: BoxOut = Field(..., description="Cargo-box temperatures (dynamic mode).")
+    series: Series | None = Field(None, description="The time series, when include_series is true.")
     grid_kwh: float = Field(
         0.0, description="Energy from the grid to pre-condition cab and box before the start."
     )
@@ -560,7 +678,7 @@ class SimulateResponse(ApiModel):
 class PresetsResponse(ApiModel):
     """Every preset with every value."""
 
-    presets: list[Preset]
+    presets: list[Preset] = Field(..., description="Every preset with every parameter value.")
 
 
 class FieldError(ApiModel):
@@ -575,9 +693,9 @@ class Problem(ApiModel):
     """An error, RFC 9457 (application/problem+json)."""
 
     type: str = Field(..., description="Problem kind, a relative URI.")
-    title: str
-    status: int
-    detail: str
+    title: str = Field(..., description="A short summary of the problem kind.")
+    status: int = Field(..., description="The HTTP status code.")
+    detail: str = Field(..., description="What went wrong, for a person.")
     errors: list[FieldError] | None = Field(None, description="For invalid requests.")
 
 
@@ -608,7 +726,7 @@ class Readiness(ApiModel):
         ...,
         description="ready; degraded (a non-critical service is down); unavailable (503).",
     )
-    checks: list[Check]
+    checks: list[Check] = Field(..., description="Each dependency's answer.")
 
 
 JobType = Literal["plan", "scenarios"]
@@ -638,11 +756,15 @@ class JobSummary(ApiModel):
     """A job's state."""
 
     id: str = Field(..., description="The job's identifier (a UUID).")
-    type: JobType
+    type: JobType = Field(..., description="plan or scenarios.")
     status: JobStatus = Field(..., description="queued, running, succeeded, failed or cancelled.")
-    created_at: AwareDatetime = Field(..., description="When it was accepted (UTC).")
-    started_at: AwareDatetime | None = Field(None, description="When its last run began.")
-    finished_at: AwareDatetime | None = Field(None, description="When it ended.")
+    created_at: AwareDatetime = Field(..., strict=False, description="When it was accepted (UTC).")
+    started_at: AwareDatetime | None = Field(
+        None, strict=False, description="When its last run began (UTC)."
+    )
+    finished_at: AwareDatetime | None = Field(
+        None, strict=False, description="When it ended (UTC)."
+    )
     attempts: int = Field(..., description="Runs so far (a lost worker means another run).")
 
 
@@ -659,4 +781,6 @@ class JobOut(JobSummary):
 class JobList(ApiModel):
     """Jobs, newest first."""
 
-    jobs: list[JobSummary]
+    jobs: list[JobSummary] = Field(
+        ..., description="The jobs, newest first, without their results."
+    )

@@ -105,7 +105,7 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
             f"{settings.max_trace_samples}",
             "speed_mps" if request.cycle is None else "cycle.distance_m",
         )
-    check_trace(speed, request.dt_s)  # before asking the weather service for its span
+    check_trace(speed, request.dt_s)  # at least 2 samples; before asking for the weather
     weather, warnings = forecast_for(
         request.weather,
         connectors.weather_service(settings),
@@ -160,16 +160,29 @@ def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepRe
     start, _ = departure(
         request.date, clock_time(request.start_time), request.timezone, request.location.lon
     )
-    sweep = speed_sweep(
-        request.speeds_kmh,
-        request.distance_m,
-        start,
-        request.location,
-        request.van(),
-        request.weather,
-        request.driver_aggressiveness,
-        request.traffic_density,
-    )
+    for index, speed_kmh in enumerate(request.speeds_kmh):
+        # Each trip is a trace of its own: at least its distance at its speed, every second.
+        if speed_kmh > 0 and request.distance_m / (speed_kmh / 3.6) > settings.max_trace_samples:
+            raise LimitExceededError(
+                f"{request.distance_m:g} m at {speed_kmh:g} km/h takes more than "
+                f"{settings.max_trace_samples} s; this server simulates at most that many samples",
+                f"speeds_kmh[{index}]",
+            )
+    try:
+        sweep = speed_sweep(
+            request.speeds_kmh,
+            request.distance_m,
+            start,
+            request.location,
+            request.van(),
+            request.weather,
+            request.driver_aggressiveness,
+            request.traffic_density,
+        )
+    except CoreError as error:
+        if error.field == "start":  # the trips would run past the year 9999
+            raise type(error)(error.message, "date") from None
+        raise
     return SpeedSweepResponse(
         points=[
             SpeedPointOut(
@@ -201,14 +214,19 @@ def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosRes
     """One round over seasons × drivers × traffic (``POST /v1/studies/scenarios``)."""
     check_scenarios(request, settings)
     seasons = request.seasons or default_seasons(request.plan.date.year)
-    grid = scenario_grid(
-        plan_problem(request.plan, settings),
-        seasons,
-        request.driver_aggressiveness,
-        request.traffic_density,
-        router=connectors.router(settings),
-        weather_service=connectors.weather_service(settings),
-    )
+    try:
+        grid = scenario_grid(
+            plan_problem(request.plan, settings),
+            seasons,
+            request.driver_aggressiveness,
+            request.traffic_density,
+            router=connectors.router(settings),
+            weather_service=connectors.weather_service(settings),
+        )
+    except CoreError as error:  # the round's own fields sit under plan.
+        if error.field is None or error.field.startswith(("seasons", "plan")):
+            raise
+        raise type(error)(error.message, f"plan.{error.field}") from None
     return ScenariosResponse(
         tour=grid.tour,
         baseline_energy_kwh=results.energy(grid.baseline_energy_kwh),

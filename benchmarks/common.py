@@ -100,16 +100,18 @@ class Server:
         self.process: subprocess.Popen[bytes] | None = None
 
     def start(self, timeout_s: float = 30.0) -> Server:
+        # The server's log goes to a file: a pipe nobody reads would fill and stall it.
+        self.log_path = Path(tempfile.mkstemp(prefix="coldroute-server-", suffix=".log")[1])
         self.process = subprocess.Popen(
             [sys.executable, "-m", "app.serve"],
             env=self.env,
             stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
+            stderr=self.log_path.open("wb"),
         )
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
             if self.process.poll() is not None:
-                raise RuntimeError(f"the server exited: {self.process.stderr.read()!r}")  # type: ignore[union-attr]
+                raise RuntimeError(f"the server exited: {self.log_path.read_text()[-2000:]}")
             try:
                 if httpx.get(f"{self.url}/healthz", timeout=1).status_code == 200:
                     return self
@@ -120,7 +122,7 @@ class Server:
     def stop(self) -> None:
         if self.process is not None and self.process.poll() is None:
             self.process.terminate()
-            self.process.wait(timeout=15)
+            self.process.wait(timeout=20)
 
     def close(self) -> None:
         self.stop()

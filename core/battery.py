@@ -62,7 +62,8 @@ class BatteryVerdict:
     min_soc, final_soc
         Lowest and last state of charge [–].
     margin_kwh
-        Energy left above the reserve at the lowest point [kWh]; negative when infeasible.
+        Energy left above the reserve at the lowest point [kWh]; negative when infeasible
+        (the shortfall, even beyond an empty battery).
     required_capacity_kwh
         Smallest nominal usable capacity that keeps the same trace above the reserve [kWh].
     usable_capacity_kwh
@@ -104,16 +105,17 @@ def discharge(
     lowest_used = np.minimum.accumulate(used_kwh) if used_kwh.size else used_kwh
     headroom_kwh = (1.0 - battery.initial_soc) * capacity_kwh
     depth_kwh = used_kwh - np.minimum(lowest_used, -headroom_kwh)
-    soc = np.concatenate(([battery.initial_soc], 1.0 - depth_kwh / capacity_kwh))
+    # Below empty the van would stop: the charge shows 0, the margin tells the shortfall.
+    uncapped = np.concatenate(([battery.initial_soc], 1.0 - depth_kwh / capacity_kwh))
+    soc = np.maximum(uncapped, 0.0)
     drawdown_kwh = used_kwh - np.minimum(lowest_used, 0.0)
     peak_draw_kwh = float(drawdown_kwh.max()) if drawdown_kwh.size else 0.0
     below = np.flatnonzero(soc < battery.min_soc - 1e-12)
-    lowest = float(soc.min())
     return soc, BatteryVerdict(
         feasible=below.size == 0,
-        min_soc=lowest,
+        min_soc=float(soc.min()),
         final_soc=float(soc[-1]),
-        margin_kwh=(lowest - battery.min_soc) * capacity_kwh,
+        margin_kwh=(float(uncapped.min()) - battery.min_soc) * capacity_kwh,
         required_capacity_kwh=peak_draw_kwh
         / (battery.initial_soc - battery.min_soc)
         / usable_share,

@@ -141,10 +141,13 @@ def local_clock(start: dt.datetime, offsets_s: FloatArray) -> LocalClock:
 
 
 def check_representable(start: dt.datetime, duration_s: float, field: str = "start") -> None:
-    """Raise if ``start + duration_s`` is beyond the year 9999 (Python's last datetime)."""
+    """Raise if ``start + duration_s`` is beyond the year 9999 (Python's last datetime), with a
+    day to spare for the local clock and the weather of the last day."""
     try:
-        at(start, duration_s)
+        at(start, duration_s + SECONDS_PER_DAY)
     except OverflowError:
         raise InvalidParameterError(
-            f"{field} plus the trace's {duration_s:,.0f} s runs past the year 9999", field
+            f"{start:%Y-%m-%d %H:%M} plus {duration_s / 3600:,.1f} h runs past the "
+            "year 9999, the last one the service can represent",
+            field,
         ) from None

@@ -16,16 +16,26 @@ class CoreError(ValueError):
         Human-readable explanation naming the field and the rule.
     field
         Dotted path of the offending field (``"stops[3].lat"``), or ``None`` for a whole request.
+    details
+        Every offending field and its rule, when there are several; by default the one.
     """
 
-    def __init__(self, message: str, field: str | None = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        field: str | None = None,
+        details: list[tuple[str, str]] | None = None,
+    ) -> None:
         super().__init__(message)
         self.message = message
         self.field = field
+        self.details = details if details is not None else [(field or "body", message)]
 
-    def __reduce__(self) -> tuple[type[CoreError], tuple[str, str | None]]:
-        # Errors cross process boundaries (worker pool, job queue) with their field.
-        return type(self), (self.message, self.field)
+    def __reduce__(
+        self,
+    ) -> tuple[type[CoreError], tuple[str, str | None, list[tuple[str, str]]]]:
+        # Errors cross process boundaries (worker pool, job queue) with their fields.
+        return type(self), (self.message, self.field, self.details)
 
 
 class InvalidParameterError(CoreError):

@@ -11,13 +11,16 @@ layer validates a request, pydantic's own error with the full field path is used
 
 from __future__ import annotations
 
+import datetime as dt
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import (
+    AwareDatetime,
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Field,
     ValidationError,
@@ -26,6 +29,19 @@ from pydantic import (
 )
 
 from core.exceptions import InvalidParameterError
+
+
+def _iso_text(value: Any) -> Any:
+    """Dates and times come as ISO 8601 text (or as Python's own objects), never as numbers."""
+    if isinstance(value, str | dt.date | dt.time):
+        return value
+    raise ValueError("expected ISO 8601 text")
+
+
+#: A calendar date from ISO text ("2026-07-15"); see :data:`IsoDateTime`.
+IsoDate = Annotated[dt.date, BeforeValidator(_iso_text), Field(strict=False)]
+#: An instant with its UTC offset from ISO text ("2026-07-15T09:00:00+02:00").
+IsoDateTime = Annotated[AwareDatetime, BeforeValidator(_iso_text), Field(strict=False)]
 
 #: Standard gravity [m/s²] (CGPM 1901).
 GRAVITY_MPS2 = 9.80665
@@ -59,7 +75,9 @@ def inside_validation() -> Iterator[None]:
 class Params(BaseModel):
     """Base of every parameter model: frozen, no unknown fields, no NaN or infinity."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+    # Strict: no number from a string or a boolean (JSON clients get what the schema says);
+    # dates and times still come from their ISO text (strict=False on those fields).
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False, strict=True)
 
     def __init__(self, **data: Any) -> None:
         if _INSIDE_VALIDATION.get():
@@ -212,7 +230,7 @@ class CargoBoxParams(Params):
     )
     carnot_fraction: float = Field(
         0.3,
-        gt=0,
+        ge=0.05,
         le=1,
         description="Share of the Carnot COP the unit reaches [–] ('carnot' model). 0.3 is fitted "
         "to the paper's η_RU = 1.5 at 30 °C outside / 4 °C box (COP 1.57) and gives 0.97 at "
@@ -367,10 +385,14 @@ class BatteryParams(Params):
 
 
 class Weather(Params):
-    """Daily extremes of the ambient temperature (paper §3.1)."""
+    """Daily extremes of the ambient temperature (paper §3.1); t_min_c must not exceed t_max_c."""
 
-    t_min_c: float = Field(..., ge=-60, le=60, description="Lowest temperature of the day [°C].")
-    t_max_c: float = Field(..., ge=-60, le=60, description="Highest temperature of the day [°C].")
+    t_min_c: float = Field(
+        ..., ge=-60, le=60, description="Lowest temperature of the day [°C]; at most t_max_c."
+    )
+    t_max_c: float = Field(
+        ..., ge=-60, le=60, description="Highest temperature of the day [°C]; at least t_min_c."
+    )
 
     @field_validator("t_max_c")
     @classmethod
@@ -440,9 +462,13 @@ AGGRESSIVE_DRIVER = 1.0
 class VanParams(Params):
     """Everything about the van that a simulation needs."""
 
-    vehicle: VehicleParams = Field(default_factory=VehicleParams)
-    cargo_box: CargoBoxParams = Field(default_factory=CargoBoxParams)
-    battery: BatteryParams = Field(default_factory=BatteryParams)
+    vehicle: VehicleParams = Field(
+        default_factory=VehicleParams, description="Longitudinal dynamics and cab consumers."
+    )
+    cargo_box: CargoBoxParams = Field(
+        default_factory=CargoBoxParams, description="Cargo box and refrigeration unit."
+    )
+    battery: BatteryParams = Field(default_factory=BatteryParams, description="Traction battery.")
     payload_kg: float = Field(
         550.0, ge=0, le=40_000, description="Payload at departure [kg] (Table 1: 550 kg)."
     )
@@ -582,12 +608,21 @@ class Stop(Depot):
         return value
 
 
+#: Longest leg a matrix may hold: 100,000 km and 30 days (beyond, the numbers are mistakes).
+MAX_MATRIX_DISTANCE_M = 1e8
+MAX_MATRIX_DURATION_S = 30 * 86_400.0
+
+
 class RoadMatrix(Params):
     """Distances and durations from the client's road router: depot first, then the stops in
     request order."""
 
-    distances_m: list[list[float]] = Field(..., description="Road distance of each pair [m].")
-    durations_s: list[list[float]] = Field(..., description="Driving time of each pair [s].")
+    distances_m: list[list[Annotated[float, Field(ge=0, le=MAX_MATRIX_DISTANCE_M)]]] = Field(
+        ..., description="Road distance of each pair [m], 0–100,000 km."
+    )
+    durations_s: list[list[Annotated[float, Field(ge=0, le=MAX_MATRIX_DURATION_S)]]] = Field(
+        ..., description="Driving time of each pair [s], 0–30 days."
+    )
     street_types: list[list[StreetTypeName]] | None = Field(
         None, description="Street type of each pair; null chooses by leg length."
     )

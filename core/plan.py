@@ -281,6 +281,7 @@ def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
     start, timezone_name = departure(
         problem.date, problem.start_time, problem.timezone, problem.depot.lon
     )
+    check_representable(start, MAX_ROUND_S, "date")  # the longest round the planner simulates
     if problem.matrix is not None:
         build_legs([problem.depot, *problem.stops], problem.matrix)
     return start, timezone_name

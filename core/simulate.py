@@ -124,11 +124,14 @@ def _per_step(
     return 0.5 * (array[:-1] + array[1:])
 
 
-def check_trace(speed_mps: ArrayLike, dt_s: float) -> FloatArray:
-    """Validate a speed trace: 1-D, at least two samples, finite, 0…250 km/h; ``dt_s`` > 0."""
+def check_trace(speed_mps: ArrayLike, dt_s: float, min_samples: int = 2) -> FloatArray:
+    """Validate a speed trace: 1-D, at least ``min_samples`` samples, finite, 0…250 km/h;
+    ``dt_s`` > 0. (A single sample is a moment: a round that never leaves the depot.)"""
     speed = np.asarray(speed_mps, dtype=float)
-    if speed.ndim != 1 or speed.size < 2:
-        raise InvalidParameterError("speed_mps must be a list of at least 2 samples", "speed_mps")
+    if speed.ndim != 1 or speed.size < min_samples:
+        raise InvalidParameterError(
+            f"speed_mps must be a list of at least {min_samples} samples", "speed_mps"
+        )
     bad = np.flatnonzero(~np.isfinite(speed) | (speed < 0) | (speed > MAX_SPEED_MPS))
     if bad.size:
         raise InvalidParameterError(
@@ -209,7 +212,7 @@ def simulate(
     -------
     SimulationResult
     """
-    speed = check_trace(speed_mps, dt_s)
+    speed = check_trace(speed_mps, dt_s, min_samples=1)
     n = speed.size
     grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
     payload = van.payload_kg if payload_kg is None else payload_kg
@@ -237,13 +240,13 @@ def simulate(
         door_open_fraction(door_openings, step_end, dt_s),
         np.broadcast_to(payload_step, ambient.shape),
         dt_s,
-        initial_c=None if van.precondition_at_depot else float(ambient[0]),
+        initial_c=None if van.precondition_at_depot else outside.start_c,
     )
     vehicle = van.vehicle
     cab_gap_j = (
         vehicle.cab_recovery_energy_j_k
-        * abs(CAB_SETPOINT_C - float(ambient[0]))
-        * float(cabin_hvac_power_w(vehicle, ambient[0]) > 0)
+        * abs(CAB_SETPOINT_C - outside.start_c)
+        * float(cabin_hvac_power_w(vehicle, outside.start_c) > 0)
     )
     headwind = (
         0.0
@@ -273,13 +276,20 @@ def simulate(
         name: float(p.sum() * dt_s / battery_model.JOULES_PER_KWH) for name, p in power.items()
     }
     energy["total"] = sum(energy.values())
+    broken = [name for name, value in energy.items() if not np.isfinite(value)]
+    if broken:  # a last guard: parameters at the edges of their ranges, combined
+        raise InvalidParameterError(
+            f"the van's parameters give no finite {broken[0]} energy; check the "
+            f"{'cargo box' if broken[0] == 'refrigeration' else 'vehicle'} parameters",
+            "cargo_box" if broken[0] == "refrigeration" else "vehicle",
+        )
     consumer_j = sum(power.values(), np.zeros(n - 1)) * dt_s
     battery_params = van.battery
     drawn_j = battery_model.battery_energy_j(battery_params, consumer_j, ambient)
-    usable_share = battery_model.capacity_factor(battery_params, float(ambient[0]))
+    usable_share = battery_model.capacity_factor(battery_params, outside.start_c)
     soc, verdict = battery_model.discharge(battery_params, drawn_j, usable_share)
     grid_j = (
-        cab_gap_j + precondition_energy_j(box_params, float(ambient[0]))
+        cab_gap_j + precondition_energy_j(box_params, outside.start_c)
         if van.precondition_at_depot
         else 0.0
     )
@@ -326,6 +336,7 @@ class _Environment:
     """Outside conditions of every step, and the cab's Table 2 power that follows from them."""
 
     ambient_c: FloatArray
+    start_c: float
     solar_heat_w: FloatArray
     cab_hvac_w: FloatArray
     wind_from_east_mps: FloatArray
@@ -347,9 +358,10 @@ def _environment(
     steps, computed every :data:`ENVIRONMENT_STEP_S` (on the last moment at most) and
     interpolated linearly."""
     per_interval = max(round(ENVIRONMENT_STEP_S / dt_s), 1)
-    first_s, last_s = 0.5 * dt_s, (n_steps - 0.5) * dt_s
+    first_s, last_s = 0.5 * dt_s, max(n_steps - 0.5, 0.5) * dt_s
     coarse_s = np.minimum(
-        first_s + per_interval * dt_s * np.arange(math.ceil((n_steps - 1) / per_interval) + 1),
+        first_s
+        + per_interval * dt_s * np.arange(math.ceil(max(n_steps - 1, 0) / per_interval) + 1),
         last_s,
     )
     clock = local_clock(start, coarse_s)
@@ -363,6 +375,7 @@ def _environment(
     still = np.zeros(0)
     return _Environment(
         ambient_c=fine(outside.ambient_c),
+        start_c=float(outside.ambient_c[0]),
         solar_heat_w=fine(_solar_heat_w(van, outside, sin_h, month)),
         cab_hvac_w=fine(cabin_hvac_power_w(van.vehicle, outside.ambient_c)),
         wind_from_east_mps=still if calm else fine(outside.wind_from_east_mps),

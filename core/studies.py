@@ -12,13 +12,14 @@ from dataclasses import dataclass
 from pydantic import Field
 
 from core.cycles import generate_leg
-from core.exceptions import InvalidParameterError
+from core.exceptions import CoreError, InvalidParameterError
 from core.params import (
     AGGRESSIVE_DRIVER,
     CALM_DRIVER,
     NORMAL_DRIVER,
     STREET_TYPES,
     Depot,
+    IsoDate,
     Location,
     Params,
     RoadMatrix,
@@ -118,7 +119,7 @@ class Season(Params):
     """A season of a scenario grid: a day and, optionally, its forecast."""
 
     name: str = Field(..., min_length=1, max_length=40, description="Label, e.g. 'winter'.")
-    date: dt.date = Field(..., description="The day the round is driven.")
+    date: IsoDate = Field(..., description="The day the round is driven, YYYY-MM-DD.")
     weather: Weather | None = Field(None, description="Forecast; absent: the climatology.")
 
 
@@ -230,7 +231,8 @@ def scenario_grid(
     cells = []
     combos = list(itertools.product(seasons, drivers, traffic))
     for done, (season, driver, density) in enumerate(combos, start=1):
-        result = plan(
+        result = _season_plan(
+            seasons.index(season),
             fixed.model_copy(
                 update={
                     "date": season.date,
@@ -246,6 +248,21 @@ def scenario_grid(
         if progress is not None:
             progress(done, len(combos))
     return ScenarioGrid(baseline.tour, baseline.energy_kwh, cells)
+
+
+def _season_plan(
+    index: int,
+    problem: PlanProblem,
+    router: RoadRouter | None,
+    weather_service: WeatherService | None,
+) -> PlanResult:
+    """A cell's plan; a date the round cannot be driven on names the season."""
+    try:
+        return plan(problem, router, weather_service)
+    except CoreError as error:
+        if error.field in ("date", "start_time"):
+            raise type(error)(error.message, f"seasons[{index}].date") from None
+        raise
 
 
 def _reordered_matrix(problem: PlanProblem, baseline: PlanResult) -> RoadMatrix | None:

@@ -93,6 +93,9 @@ async def readiness(
         checks.append(_check("weather", _http_probe(settings.weather_url), critical=False))
     results = await asyncio.gather(*checks)
     down = [c for c in results if not c.ok and c.critical]
-    status = "unavailable" if down else ("degraded" if any(not c.ok for c in results) else "ready")
-    body = Readiness(status=status, checks=list(results))
+    degraded = any(not c.ok for c in results)
+    body = Readiness(
+        status="unavailable" if down else "degraded" if degraded else "ready",
+        checks=list(results),
+    )
     return JSONResponse(body.model_dump(mode="json"), status_code=503 if down else 200)

@@ -64,7 +64,10 @@ def _summary(job: JobView) -> dict[str, Any]:
 
 
 def _out(job: JobView) -> JobOut:
-    return JobOut.model_validate(_summary(job) | {"result": job.result, "error": job.error})
+    # The stored result is JSON (times as text): read it back as JSON is read, not strictly.
+    return JobOut.model_validate(
+        _summary(job) | {"result": job.result, "error": job.error}, strict=False
+    )
 
 
 def _get(store: JobStore, job_id: str) -> JobView:

@@ -84,6 +84,7 @@ async def create_plan(
     leg's speed profile come from the OSRM road router. Solved in a worker process; when every
     worker is busy the request waits in a bounded queue (503 with Retry-After beyond it)."""
     result = await pool.run(work.run_plan, request, settings, disconnected=http.is_disconnected)
+    http.app.state.metrics.solve.observe(result.solver_runtime_s)
     if wants_geojson(accept):
         collection = plan_geojson(result, request.depot.lat, request.depot.lon)
         return JSONResponse(collection.model_dump(mode="json"), media_type=GEOJSON)

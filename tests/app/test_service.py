@@ -3,7 +3,16 @@ from pathlib import Path
 
 from fastapi.testclient import TestClient
 
+from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
 from app.main import app, create_app
+from app.openapi_doc import RESPONSE_EXAMPLES
+from app.schemas import (
+    JobOut,
+    PlanResponse,
+    ScenariosResponse,
+    SimulateResponse,
+    SpeedSweepResponse,
+)
 from app.settings import Settings
 from core.params import PRESETS
 
@@ -20,24 +29,40 @@ def test_operation_ids_are_stable():
     assert ids >= {"createPlan", "simulateTrace", "listPresets", "getHealth"}
 
 
-def test_every_request_field_is_described():
+def test_every_property_of_every_schema_is_described():
+    # Requests and answers alike: a property is described itself, or is a reference to (or a
+    # nullable reference to) a schema that is.
     schemas = app.openapi()["components"]["schemas"]
-    for name in (
-        "PlanRequest",
-        "SimulateRequest",
-        "VehicleRequest",
-        "CargoBoxRequest",
-        "Stop",
-        "Depot",
-        "Weather",
-    ):
-        for field, spec in schemas[name]["properties"].items():
-            assert (
-                spec.get("description")
-                or "$ref" in spec
-                or "allOf" in spec
-                or ("anyOf" in spec and any("$ref" in s for s in spec["anyOf"]))
-            ), (name, field)
+
+    def described(spec: dict) -> bool:
+        if spec.get("description"):
+            return True
+        refs = [spec, *spec.get("anyOf", []), *spec.get("allOf", []), *spec.get("oneOf", [])]
+        targets = [r["$ref"].rsplit("/", 1)[-1] for r in refs if "$ref" in r]
+        return bool(targets) and all(schemas[t].get("description") for t in targets)
+
+    missing = [
+        f"{name}.{field}"
+        for name, schema in schemas.items()
+        for field, spec in schema.get("properties", {}).items()
+        if not described(spec)
+    ]
+    assert missing == []
+
+
+def test_every_operation_documents_only_problem_json_errors():
+    for path, operations in app.openapi()["paths"].items():
+        for method, operation in operations.items():
+            for status, response in operation["responses"].items():
+                # /readyz's 503 is its own report (which dependency is down), not a problem.
+                if int(status) >= 400 and (path, status) != ("/readyz", "503"):
+                    assert list(response["content"]) == ["application/problem+json"], (
+                        path,
+                        method,
+                        status,
+                    )
+            if method == "get":  # no body: no 413 and no 422 for one
+                assert "413" not in operation["responses"], path
 
 
 def test_presets_and_health(client):
@@ -69,3 +94,24 @@ def test_cors_when_configured():
         headers={"Origin": "https://dispatch.example", "Access-Control-Request-Method": "GET"},
     )
     assert response.headers["access-control-allow-origin"] == "https://dispatch.example"
+
+
+def test_answer_examples_are_real_answers_of_the_request_examples(client):
+    # `make openapi` records them by running the request examples; they must still be what
+    # the server answers (and valid answers by their own schemas).
+    recorded = json.loads(RESPONSE_EXAMPLES.read_text())
+    for key, model in (
+        ("plan", PlanResponse),
+        ("simulate", SimulateResponse),
+        ("speed_sweep", SpeedSweepResponse),
+        ("scenarios", ScenariosResponse),
+        ("job", JobOut),
+    ):
+        model.model_validate(recorded[key], strict=False)
+    plan = client.post("/v1/plans", json=PLAN_EXAMPLE).json()
+    assert plan["tour"] == recorded["plan"]["tour"]
+    assert plan["totals"] == recorded["plan"]["totals"]
+    simulated = client.post("/v1/simulate", json=SIMULATE_EXAMPLE).json()
+    assert simulated["energy_kwh"] == recorded["simulate"]["energy_kwh"]
+    shown = app.openapi()["paths"]["/v1/plans"]["post"]["responses"]["200"]["content"]
+    assert shown["application/json"]["example"] == recorded["plan"]

@@ -60,7 +60,7 @@ def test_standstill_has_no_consumption_per_km(client):
         ({"dt_s": 0}, "dt_s"),
         ({"start": "2026-01-20T08:30:00"}, "start"),
         ({"location": {"lat": 91, "lon": 0}}, "location.lat"),
-        ({"cycle": {"distance_m": 1000}}, "body"),
+        ({"cycle": {"distance_m": 1000}}, "cycle"),
         ({"door_openings": [{"start_s": 100, "duration_s": 5}]}, "door_openings[0].start_s"),
     ],
 )

@@ -168,7 +168,7 @@ def test_small_battery_is_infeasible():
         ([0, -1, 0], {}, "speed_mps[1]"),
         ([0, float("nan"), 0], {}, "speed_mps[1]"),
         ([0, 300, 0], {}, "speed_mps[1]"),
-        ([0], {}, "speed_mps"),
+        ([], {}, "speed_mps"),  # one sample is a moment (a round that never leaves)
         ([0, 1, 0], {"dt_s": 0.0}, "dt_s"),
         ([0, 1, 0], {"grade": [0.0, 0.1]}, "grade"),
         ([0, 1, 0], {"grade": [0.0, 0.9, 0.0]}, "grade[1]"),

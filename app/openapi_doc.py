@@ -1,0 +1,88 @@
+"""The OpenAPI document says what the server does: which statuses each operation can return
+(problems as ``application/problem+json``), the API key as a security scheme (optional, as the
+server may not set one), the GeoJSON answer's schema and realistic answer examples."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel
+from pydantic.json_schema import models_json_schema
+
+PROBLEM_JSON = "application/problem+json"
+#: Recorded answers of the request examples (``python -m app.examples``), shown in Swagger.
+RESPONSE_EXAMPLES = Path(__file__).with_name("response_examples.json")
+
+STATUS_TEXT = {
+    401: "Missing or wrong X-API-Key (when the server sets a key).",
+    404: "No such job (or it expired).",
+    409: "The job has already ended, or the Idempotency-Key names another request.",
+    413: "Request body larger than the server accepts.",
+    422: "Invalid request: every offending field named by its JSON path.",
+    503: "The service cannot take this now (workers busy, shutting down, or an outside "
+    "service down); see Retry-After.",
+}
+#: The error statuses each operation can answer.
+ERRORS: dict[str, tuple[int, ...]] = {
+    "createPlan": (401, 413, 422, 503),
+    "simulateTrace": (401, 413, 422, 503),
+    "sweepSpeeds": (401, 413, 422, 503),
+    "runScenarios": (401, 413, 422, 503),
+    "listPresets": (401,),
+    "createJob": (401, 409, 413, 422, 503),
+    "listJobs": (401, 422, 503),
+    "getJob": (401, 404, 422, 503),
+    "cancelJob": (401, 404, 409, 422, 503),
+}
+#: Which recorded example answers which operation.
+EXAMPLES = {
+    "createPlan": "plan",
+    "simulateTrace": "simulate",
+    "sweepSpeeds": "speed_sweep",
+    "runScenarios": "scenarios",
+    "getJob": "job",
+}
+
+
+def finish(schema: dict[str, Any], extra_models: list[type[BaseModel]]) -> dict[str, Any]:
+    """Complete FastAPI's document (in place) and return it."""
+    components = schema.setdefault("components", {})
+    schemas = components.setdefault("schemas", {})
+    _, definitions = models_json_schema(
+        [(model, "serialization") for model in extra_models],
+        ref_template="#/components/schemas/{model}",
+    )
+    schemas.update(definitions.get("$defs", {}))
+    for name in ("HTTPValidationError", "ValidationError"):
+        schemas.pop(name, None)
+    components["securitySchemes"] = {
+        "ApiKey": {
+            "type": "apiKey",
+            "in": "header",
+            "name": "X-API-Key",
+            "description": "Needed when the server sets COLDROUTE_API_KEY; otherwise leave it out.",
+        }
+    }
+    examples = json.loads(RESPONSE_EXAMPLES.read_text()) if RESPONSE_EXAMPLES.exists() else {}
+    for path, operations in schema.get("paths", {}).items():
+        for operation in operations.values():
+            operation_id = operation.get("operationId", "")
+            responses = operation.setdefault("responses", {})
+            for status in [s for s in responses if s.startswith(("4", "5"))]:
+                if not (operation_id == "getReadiness" and status == "503"):
+                    del responses[status]
+            for status in ERRORS.get(operation_id, ()):
+                responses[str(status)] = {
+                    "description": STATUS_TEXT[status],
+                    "content": {PROBLEM_JSON: {"schema": {"$ref": "#/components/schemas/Problem"}}},
+                }
+            if path.startswith("/v1/"):
+                # Either the key or nothing: the server decides whether it wants one.
+                operation["security"] = [{"ApiKey": []}, {}]
+            recorded = examples.get(EXAMPLES.get(operation_id, ""))
+            content = responses.get("200", {}).get("content", {}).get("application/json")
+            if recorded is not None and content is not None:
+                content["example"] = recorded
+    return schema

@@ -1,0 +1,46 @@
+"""The full path template of a request ("/v1/jobs/{job_id}") and the methods documented there,
+read from the OpenAPI paths. (FastAPI's route objects hold their path relative to the router
+they were declared in, so ``scope["route"].path`` says "/plans" for "/v1/plans".)"""
+
+from __future__ import annotations
+
+import re
+from functools import cached_property
+from typing import Any
+
+
+class RouteTemplates:
+    """The documented paths of one application, matched against request paths."""
+
+    def __init__(self, app: Any) -> None:
+        self.app = app
+
+    @cached_property
+    def _patterns(self) -> list[tuple[re.Pattern[str], str, frozenset[str]]]:
+        paths: dict[str, dict[str, Any]] = self.app.openapi().get("paths", {})
+        # Literal paths before templated ones: "/v1/presets" is not "/v1/presets/{name}".
+        ordered = sorted(paths.items(), key=lambda item: item[0].count("{"))
+        return [
+            (
+                re.compile(re.sub(r"\\\{[^/]+?\\\}", "[^/]+", re.escape(template))),
+                template,
+                frozenset(method.upper() for method in operations),
+            )
+            for template, operations in ordered
+        ]
+
+    def template(self, path: str) -> str | None:
+        """The documented template that ``path`` matches, if any."""
+        for pattern, template, _ in self._patterns:
+            if pattern.fullmatch(path):
+                return template
+        return None
+
+    def methods(self, path: str) -> set[str]:
+        """Every method documented at ``path``."""
+        return {
+            method
+            for pattern, _, methods in self._patterns
+            if pattern.fullmatch(path)
+            for method in methods
+        }
