@@ -36,7 +36,12 @@ $(CHROMIUM):
 test: lint $(OSRM) $(CHROMIUM)
 	$(BIN)/python -m pytest
 
-bench: $(STAMP) $(OSRM)
+BENCH_STAMP := $(VENV)/.bench-installed
+$(BENCH_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[dev,bench]'
+	touch $(BENCH_STAMP)
+
+bench: $(BENCH_STAMP) $(OSRM)
 	$(BIN)/python -m benchmarks
 
 # A road router for your region: make router PBF=region.osm.pbf, then make router-serve.

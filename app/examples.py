@@ -42,6 +42,46 @@ PLAN_EXAMPLE: dict[str, Any] = {
     "objective": "energy",
 }
 
+# The same day's stops for a fleet of two, with the shops' receiving windows: the bakery café
+# and the pharmacy take goods before they open, the supermarkets in the late morning.
+_WINDOWS = {
+    "cafe-innere-stadt": [{"start": "07:00", "end": "08:00"}],
+    "apotheke-margareten": [{"start": "07:00", "end": "08:30"}],
+    "billa-landstrasse": [{"start": "10:00", "end": "12:00"}],
+    "billa-leopoldstadt": [{"start": "10:00", "end": "12:00"}],
+    "merkur-mariahilf": [{"start": "07:00", "end": "09:00"}, {"start": "13:00", "end": "15:00"}],
+}
+FLEET_PLAN_EXAMPLE: dict[str, Any] = {
+    "date": "2026-07-15",
+    "timezone": "Europe/Vienna",
+    "depot": PLAN_EXAMPLE["depot"],
+    "vehicles": [
+        {
+            "id": "van-1",
+            "vehicle": {"preset": "ev-van-3.5t-reefer"},
+            "payload_kg": 500,
+            "shift_start": "06:30",
+            "shift_end": "14:30",
+        },
+        {
+            "id": "van-2",
+            "vehicle": {"preset": "paper-generic"},
+            "payload_kg": 400,
+            "battery": {"usable_capacity_kwh": 40, "min_soc": 0.15},
+            "shift_start": "06:30",
+            "shift_end": "14:30",
+        },
+    ],
+    "stops": [
+        stop | ({"time_windows": _WINDOWS[stop["id"]]} if stop["id"] in _WINDOWS else {})
+        for stop in PLAN_EXAMPLE["stops"]
+    ],
+    "weather": {"t_min_c": 18, "t_max_c": 31},
+    "objective": "energy",
+    "minimize_vehicles": True,
+    "time_limit_s": 2,
+}
+
 SIMULATE_EXAMPLE: dict[str, Any] = {
     "cycle": {"street_type": "urban", "distance_m": 8000, "driver_aggressiveness": 0.5},
     "start": "2026-07-15T11:00:00+02:00",
@@ -89,8 +129,9 @@ def record() -> dict[str, Any]:
     import datetime as dt
 
     from app import work
-    from app.routers.results import plan_response
+    from app.routers.results import fleet_response, plan_response
     from app.schemas import (
+        FleetPlanRequest,
         JobOut,
         PlanRequest,
         ScenariosRequest,
@@ -115,6 +156,9 @@ def record() -> dict[str, Any]:
     )
     return {
         "plan": plan_json,
+        "fleet_plan": fleet_response(
+            work.run_fleet_plan(FleetPlanRequest.model_validate(FLEET_PLAN_EXAMPLE), settings)
+        ).model_dump(mode="json"),
         "simulate": work.simulate_trace(
             SimulateRequest.model_validate(SIMULATE_EXAMPLE), settings
         ).model_dump(mode="json"),

@@ -28,7 +28,7 @@ from app.execution import Executor
 from app.jobs.runner import CeleryDispatcher, LocalRunner
 from app.jobs.store import store_for
 from app.metrics import Metrics
-from app.routers import health, jobs, plans, presets, simulate, studies
+from app.routers import fleet, health, jobs, plans, presets, simulate, studies
 from app.routes import RouteTemplates
 from app.schemas import PlanFeatureCollection
 from app.settings import Settings, get_settings
@@ -41,6 +41,9 @@ Route planning and energy simulation for **all-electric refrigerated delivery va
 `POST /v1/plans` orders a round's stops with OR-Tools, simulates every leg with the
 drive-train, cab and refrigeration model of *"Wholistic simulation of an all-electric
 refrigerated delivery vehicle"* and says whether the battery holds out with its reserve.
+`POST /v1/fleet-plans` splits the day's stops across several vans with time windows,
+shifts, payload and each battery as constraints, and verifies every route by the full
+simulation.
 `POST /v1/simulate` gives the energy of one speed trace. Units are in the field names
 (`_m`, `_s`, `_kwh`, `_c`...). Errors are `application/problem+json` (RFC 9457).
 """
@@ -333,7 +336,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.metrics = metrics
     errors.install(app)
     v1 = APIRouter(prefix="/v1", dependencies=[Depends(require_api_key)])
-    for module in (plans, simulate, presets, studies, jobs):
+    for module in (plans, fleet, simulate, presets, studies, jobs):
         v1.include_router(module.router)
     app.include_router(v1)
     app.include_router(health.router)

@@ -27,6 +27,7 @@ STATUS_TEXT = {
 #: The error statuses each operation can answer.
 ERRORS: dict[str, tuple[int, ...]] = {
     "createPlan": (401, 413, 422, 503),
+    "createFleetPlan": (401, 413, 422, 503),
     "simulateTrace": (401, 413, 422, 503),
     "sweepSpeeds": (401, 413, 422, 503),
     "runScenarios": (401, 413, 422, 503),
@@ -39,6 +40,7 @@ ERRORS: dict[str, tuple[int, ...]] = {
 #: Which recorded example answers which operation.
 EXAMPLES = {
     "createPlan": "plan",
+    "createFleetPlan": "fleet_plan",
     "simulateTrace": "simulate",
     "sweepSpeeds": "speed_sweep",
     "runScenarios": "scenarios",

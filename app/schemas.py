@@ -13,17 +13,22 @@ from pydantic import (
     Field,
     ModelWrapValidatorHandler,
     ValidationError,
+    ValidationInfo,
     create_model,
+    field_validator,
     model_validator,
 )
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from core.exceptions import InvalidParameterError
+from core.fleet import MAX_VEHICLES, UnassignedReason, shift_in_order
 from core.params import (
     DEFAULT_PRESET,
+    HHMM_PATTERN,
     NORMAL_DRIVER,
     BatteryParams,
     CargoBoxParams,
+    ClockTime,
     Depot,
     DoorOpening,
     Interval,
@@ -45,15 +50,6 @@ from core.params import (
 from core.studies import Season
 from core.tsp import SolverStatus
 from core.weather import WeatherSource
-
-#: A local clock time as the API writes it.
-HHMM_PATTERN = r"^([01]\d|2[0-3]):[0-5]\d$"
-
-
-def clock_time(text: str) -> dt.time:
-    """``"09:30"`` → ``time(9, 30)`` (the text has passed :data:`HHMM_PATTERN`)."""
-    hour, minute = (int(part) for part in text.split(":"))
-    return dt.time(hour, minute)
 
 
 class ApiModel(BaseModel):
@@ -178,7 +174,10 @@ class VanRequest(ApiModel):
     def van(self) -> VanParams:
         """The preset with this request's changes applied, validated by the core models; an
         error names the request section (``cargo_box.setpoint_c``)."""
-        preset: Preset = get_preset(getattr(self.vehicle, "preset"))  # noqa: B009
+        try:
+            preset: Preset = get_preset(getattr(self.vehicle, "preset"))  # noqa: B009
+        except InvalidParameterError as error:
+            raise InvalidParameterError(error.message, "vehicle.preset") from None
         sections = {
             "vehicle": (VehicleParams, preset.vehicle),
             "cargo_box": (CargoBoxParams, preset.cargo_box),
@@ -208,11 +207,10 @@ class VanRequest(ApiModel):
         return VanParams(**built, payload_kg=payload, precondition_at_depot=precondition)
 
 
-class PlanRequest(VanRequest):
-    """A delivery round to plan: depot, stops, date, van and conditions."""
+class RoundRequest(ApiModel):
+    """What a plan and a fleet plan share: the day, the places and the conditions."""
 
     date: IsoDate = Field(..., description="Day of the round, YYYY-MM-DD.")
-    start_time: str = Field("08:00", pattern=HHMM_PATTERN, description="Departure, local HH:MM.")
     timezone: str | None = Field(
         None,
         max_length=64,
@@ -233,7 +231,6 @@ class PlanRequest(VanRequest):
     matrix: RoadMatrix | None = Field(
         None, description="Road distances/durations from your router: depot first, then stops."
     )
-    keep_order: bool = Field(False, description="Drive the stops in the given order.")
     time_limit_s: float = Field(
         1.0, gt=0, le=600, description="Solver budget [s], capped by the server's setting."
     )
@@ -242,6 +239,20 @@ class PlanRequest(VanRequest):
         description="Return each leg's road as a GeoJSON LineString in legs[].geometry (the "
         "router's road with OSRM, else the straight line).",
     )
+
+
+class PlanRequest(VanRequest, RoundRequest):
+    """A delivery round to plan: depot, stops, date, van and conditions. Stops with
+    time_windows are served inside them (the van waits when early); when no order can, the
+    answer is a 422 naming the stop that cannot be reached in time."""
+
+    start_time: str = Field(
+        "08:00",
+        pattern=HHMM_PATTERN,
+        description="Departure, local HH:MM (with time windows: the earliest; the van leaves "
+        "later when the first stop's window opens later).",
+    )
+    keep_order: bool = Field(False, description="Drive the stops in the given order.")
 
 
 class EnergyKwh(ApiModel):
@@ -309,6 +320,12 @@ class StopOut(ApiModel):
 
     id: str = Field(..., description="The stop's id.")
     arrival: dt.datetime = Field(..., description="Arrival, local time with UTC offset.")
+    service_start: dt.datetime = Field(
+        ..., description="Service begins (inside a time window), local time with UTC offset."
+    )
+    wait_s: float = Field(
+        ..., description="Waiting for the stop's time window to open, parked [s]."
+    )
     departure: dt.datetime = Field(
         ..., description="Departure after the service, local time with UTC offset."
     )
@@ -441,6 +458,123 @@ class PlanResponse(ApiModel):
         default_factory=list,
         description="What the plan had to do without (e.g. the weather service was down and "
         "the climatology was used).",
+    )
+    attribution: str | None = Field(
+        None, description="Credit for the map data the legs were routed on."
+    )
+
+
+class FleetVehicleRequest(VanRequest):
+    """One van of the fleet: the van exactly as in /v1/plans (a preset and the parameters to
+    change) and its driver's shift."""
+
+    id: str = Field(
+        ..., min_length=1, max_length=64, description="Identifier of the van, unique in the fleet."
+    )
+    shift_start: ClockTime = Field(
+        dt.time(8, 0), description="Earliest departure from the depot, local HH:MM."
+    )
+    shift_end: ClockTime = Field(
+        dt.time(18, 0),
+        description="Latest return to the depot, local HH:MM, after shift_start (same day).",
+    )
+
+    @field_validator("shift_end")
+    @classmethod
+    def _after_start(cls, value: dt.time, info: ValidationInfo) -> dt.time:
+        return shift_in_order(info.data.get("shift_start"), value)
+
+
+class FleetPlanRequest(RoundRequest):
+    """The day's stops and the fleet that serves them from one depot."""
+
+    vehicles: list[FleetVehicleRequest] = Field(
+        ...,
+        min_length=1,
+        max_length=MAX_VEHICLES,
+        description="The vans that may drive, each with its van, battery, payload and shift; "
+        "those listed first drive first when as good.",
+    )
+    minimize_vehicles: bool = Field(
+        True, description="Fewer vans first, then the objective; false: the objective alone."
+    )
+    time_limit_s: float = Field(
+        5.0, gt=0, le=600, description="Solver budget [s], capped by the server's setting."
+    )
+
+
+class FleetRouteOut(PlanResponse):
+    """The planned and simulated day of one van, as a /v1/plans answer, with the van's id."""
+
+    vehicle_id: str = Field(..., description="The van that drives this route.")
+
+
+class UnassignedOut(ApiModel):
+    """A stop no van serves."""
+
+    id: str = Field(..., description="The stop's id.")
+    reason: UnassignedReason = Field(
+        ...,
+        description="time_window (no van reaches it inside a window), capacity (no payload "
+        "left or too heavy), battery (the charge would fall below a reserve), shift (no van "
+        "back in time) or unreachable (no road).",
+    )
+    detail: str = Field(..., description="Why, in a sentence.")
+
+
+class FleetTotals(ApiModel):
+    """Every route of the fleet together."""
+
+    distance_m: float = Field(..., description="Distance driven by every van [m].")
+    duration_s: float = Field(
+        ..., description="Sum of each van's time from departure to return [s]."
+    )
+    energy_kwh: EnergyKwh = Field(..., description="Energy of each consumer over the fleet [kWh].")
+    grid_kwh: float = Field(
+        ..., description="Pre-conditioning from the grid at the depot, every van [kWh]."
+    )
+    vehicles_used: int = Field(..., description="Vans that drive.")
+
+
+class FleetSolverOut(ApiModel):
+    """How the fleet search ended."""
+
+    status: SolverStatus = Field(
+        ..., description="feasible: the best found in the time limit (no proof of optimality)."
+    )
+    objective: Objective = Field(..., description="What the routes minimised.")
+    objective_value: float = Field(
+        ..., description="Of every route together, in m, s or Wh (estimate)."
+    )
+    runtime_s: float = Field(..., description="Time the search and the verification took [s].")
+    verification_rounds: int = Field(
+        ...,
+        description="How often the routes were simulated in full; above 1 when a simulation "
+        "broke a rule the estimates missed and the fleet was solved again.",
+    )
+
+
+class FleetPlanResponse(ApiModel):
+    """The fleet's day: every route verified by the full simulation."""
+
+    routes: list[FleetRouteOut] = Field(
+        ...,
+        description="One per van that drives, in the order of vehicles[]: everything a "
+        "/v1/plans answer holds.",
+    )
+    unassigned: list[UnassignedOut] = Field(
+        ..., description="Stops no van serves, in request order, each with its reason."
+    )
+    totals: FleetTotals = Field(..., description="Every route together.")
+    solver: FleetSolverOut = Field(..., description="How the search ended.")
+    timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
+    distance_source: Literal["osrm", "client", "estimate"] = Field(
+        ...,
+        description="Where the legs' distances and durations came from: the OSRM router, the "
+        "request's matrix, or the great-circle estimate.",
+    )
+    warnings: list[str] = Field(
+        default_factory=list, description="What the plan had to do without."
     )
     attribution: str | None = Field(
         None, description="Credit for the map data the legs were routed on."
@@ -729,7 +863,9 @@ class Readiness(ApiModel):
     checks: list[Check] = Field(..., description="Each dependency's answer.")
 
 
-JobType = Literal["plan", "scenarios"]
+JobType = Literal["plan", "fleet-plan", "scenarios"]
+#: The request of each job type: the synchronous endpoint's body.
+JobRequest = PlanRequest | FleetPlanRequest | ScenariosRequest
 JobStatus = Literal["queued", "running", "succeeded", "failed", "cancelled"]
 
 
@@ -737,7 +873,9 @@ class JobSubmission(ApiModel):
     """A job: the type and the body the synchronous endpoint would take."""
 
     type: JobType = Field(
-        ..., description="plan: the body of POST /v1/plans; scenarios: of /v1/studies/scenarios."
+        ...,
+        description="plan: the body of POST /v1/plans; fleet-plan: of /v1/fleet-plans; "
+        "scenarios: of /v1/studies/scenarios.",
     )
     request: dict[str, Any] = Field(
         ...,
@@ -746,6 +884,7 @@ class JobSubmission(ApiModel):
         json_schema_extra={
             "oneOf": [
                 {"$ref": "#/components/schemas/PlanRequest"},
+                {"$ref": "#/components/schemas/FleetPlanRequest"},
                 {"$ref": "#/components/schemas/ScenariosRequest"},
             ]
         },
@@ -756,7 +895,7 @@ class JobSummary(ApiModel):
     """A job's state."""
 
     id: str = Field(..., description="The job's identifier (a UUID).")
-    type: JobType = Field(..., description="plan or scenarios.")
+    type: JobType = Field(..., description="plan, fleet-plan or scenarios.")
     status: JobStatus = Field(..., description="queued, running, succeeded, failed or cancelled.")
     created_at: AwareDatetime = Field(..., strict=False, description="When it was accepted (UTC).")
     started_at: AwareDatetime | None = Field(
@@ -771,7 +910,7 @@ class JobSummary(ApiModel):
 class JobOut(JobSummary):
     """A job, with its answer once it has one."""
 
-    result: PlanResponse | ScenariosResponse | None = Field(
+    result: PlanResponse | FleetPlanResponse | ScenariosResponse | None = Field(
         None,
         description="When succeeded: exactly what the synchronous endpoint returns.",
     )

@@ -7,14 +7,18 @@ every result pickles. A job's result is exactly what the synchronous endpoint re
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
+from pydantic import BaseModel
 
 from app import connectors
 from app.routers import results
 from app.schemas import (
     ConsumptionWhPerKm,
+    FleetPlanRequest,
+    JobRequest,
+    JobType,
     PlanRequest,
     PowerSeries,
     ScenarioCellOut,
@@ -26,19 +30,19 @@ from app.schemas import (
     SpeedPointOut,
     SpeedSweepRequest,
     SpeedSweepResponse,
-    clock_time,
 )
 from app.settings import Settings
 from core.clock import departure
 from core.cycles import generate_leg
 from core.exceptions import CoreError, LimitExceededError
-from core.params import STREET_TYPES
-from core.plan import PlanProblem, PlanResult, check, plan
+from core.fleet import FleetProblem, FleetResult, FleetVehicle, check_fleet, plan_fleet
+from core.params import STREET_TYPES, clock_time
+from core.plan import check, plan
+from core.round import PlanProblem, PlanResult
 from core.simulate import check_trace, simulate
 from core.studies import default_seasons, scenario_grid, speed_sweep
 from core.weather import forecast_for
 
-JobType = Literal["plan", "scenarios"]
 #: Shortest distance for which energy per km is reported [m].
 MIN_DISTANCE_FOR_PER_KM_M = 1.0
 
@@ -64,6 +68,54 @@ def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
         matrix=request.matrix,
         keep_order=request.keep_order,
         time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
+    )
+
+
+def fleet_problem(request: FleetPlanRequest, settings: Settings) -> FleetProblem:
+    """The core problem of a fleet plan request, within the server's limits; a van's own
+    errors name it (``vehicles[1].battery.min_soc``)."""
+    if len(request.stops) > settings.max_stops:
+        raise LimitExceededError(
+            f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
+            "stops",
+        )
+    vehicles = []
+    for index, vehicle in enumerate(request.vehicles):
+        try:
+            van = vehicle.van()
+        except CoreError as error:
+            details = [(f"vehicles[{index}].{field}", rule) for field, rule in error.details]
+            raise type(error)(error.message, details[0][0], details) from None
+        vehicles.append(
+            FleetVehicle(
+                id=vehicle.id,
+                van=van,
+                shift_start=vehicle.shift_start,
+                shift_end=vehicle.shift_end,
+            )
+        )
+    return FleetProblem(
+        date=request.date,
+        timezone=request.timezone,
+        depot=request.depot,
+        vehicles=vehicles,
+        stops=request.stops,
+        objective=request.objective,
+        minimize_vehicles=request.minimize_vehicles,
+        weather=request.weather,
+        driver_aggressiveness=request.driver_aggressiveness,
+        traffic_density=request.traffic_density,
+        matrix=request.matrix,
+        time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
+    )
+
+
+def run_fleet_plan(request: FleetPlanRequest, settings: Settings) -> FleetResult:
+    """Plan the fleet's day with the configured road router and weather service."""
+    return plan_fleet(
+        fleet_problem(request, settings),
+        connectors.router(settings),
+        connectors.weather_service(settings),
     )
 
 
@@ -237,18 +289,19 @@ def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosRes
     )
 
 
-def check_job(
-    job_type: JobType, request: PlanRequest | ScenariosRequest, settings: Settings
-) -> None:
+def check_job(job_type: JobType, request: JobRequest, settings: Settings) -> None:
     """Refuse at submission what would fail at once: everything but the solve itself."""
     if isinstance(request, PlanRequest):
         check(plan_problem(request, settings))
-        return
-    check_scenarios(request, settings)
-    try:
-        check(plan_problem(request.plan, settings))
-    except CoreError as error:
-        raise type(error)(error.message, f"plan.{error.field}" if error.field else "plan") from None
+    elif isinstance(request, FleetPlanRequest):
+        check_fleet(fleet_problem(request, settings))
+    else:
+        check_scenarios(request, settings)
+        try:
+            check(plan_problem(request.plan, settings))
+        except CoreError as error:
+            field = f"plan.{error.field}" if error.field else "plan"
+            raise type(error)(error.message, field) from None
 
 
 def run_job(job_type: JobType, request: dict[str, Any], settings: Settings) -> dict[str, Any]:
@@ -257,8 +310,14 @@ def run_job(job_type: JobType, request: dict[str, Any], settings: Settings) -> d
     settings = settings.model_copy(update={"max_time_limit_s": settings.max_job_time_limit_s})
     if job_type == "plan":
         plan_request = PlanRequest.model_validate(request)
-        answer = results.plan_response(
+        answer: BaseModel = results.plan_response(
             run_plan(plan_request, settings), plan_request.include_geometry
         )
-        return answer.model_dump(mode="json")
-    return run_scenarios(ScenariosRequest.model_validate(request), settings).model_dump(mode="json")
+    elif job_type == "fleet-plan":
+        fleet_request = FleetPlanRequest.model_validate(request)
+        answer = results.fleet_response(
+            run_fleet_plan(fleet_request, settings), fleet_request.include_geometry
+        )
+    else:
+        answer = run_scenarios(ScenariosRequest.model_validate(request), settings)
+    return answer.model_dump(mode="json")

@@ -1,6 +1,13 @@
 """Run every benchmark: ``python -m benchmarks`` (``make bench``)."""
 
-from benchmarks import bench_energy, bench_planner, bench_roads, bench_serving, bench_studies
+from benchmarks import (
+    bench_energy,
+    bench_fleet,
+    bench_planner,
+    bench_roads,
+    bench_serving,
+    bench_studies,
+)
 
-for module in (bench_energy, bench_planner, bench_roads, bench_studies, bench_serving):
+for module in (bench_energy, bench_planner, bench_roads, bench_studies, bench_fleet, bench_serving):
     module.main()

@@ -11,7 +11,8 @@ import numpy as np
 
 from benchmarks.common import REFERENCE, busy_core, euc_2d_matrix, print_table
 from core.params import Depot, Stop
-from core.plan import PlanProblem, plan
+from core.plan import plan
+from core.round import PlanProblem
 from core.tsp import solve_tour
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from benchmarks.common import best_time_s, print_table
 from core.params import Depot, Location, Stop, VanParams, Weather
-from core.plan import PlanProblem
+from core.round import PlanProblem
 from core.studies import Season, scenario_grid, speed_sweep
 
 

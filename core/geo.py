@@ -63,6 +63,11 @@ class Legs:
         """Street type of the leg from ``i`` to ``j``."""
         return STREET_TYPE_NAMES[int(self.street_type[i, j])]
 
+    def unreachable(self) -> list[int]:
+        """Places with no road from or to the depot (a router's null), by index (≥ 1)."""
+        known = np.isfinite(self.distance_m) & np.isfinite(self.duration_s)
+        return [int(i) for i in np.flatnonzero(~(known[0] & known[:, 0])) if i > 0]
+
 
 def great_circle_m(lat: FloatArray, lon: FloatArray) -> FloatArray:
     """Great-circle distance of every pair of points [m] (haversine, mean Earth radius).

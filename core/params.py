@@ -12,6 +12,7 @@ layer validates a request, pydantic's own error with the full field path is used
 from __future__ import annotations
 
 import datetime as dt
+import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -23,10 +24,13 @@ from pydantic import (
     BeforeValidator,
     ConfigDict,
     Field,
+    PlainSerializer,
     ValidationError,
     ValidationInfo,
+    WithJsonSchema,
     field_validator,
 )
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from core.exceptions import InvalidParameterError
 
@@ -42,6 +46,29 @@ def _iso_text(value: Any) -> Any:
 IsoDate = Annotated[dt.date, BeforeValidator(_iso_text), Field(strict=False)]
 #: An instant with its UTC offset from ISO text ("2026-07-15T09:00:00+02:00").
 IsoDateTime = Annotated[AwareDatetime, BeforeValidator(_iso_text), Field(strict=False)]
+
+#: A local clock time as the API writes it: HH:MM, 00:00–23:59.
+HHMM_PATTERN = r"^([01]\d|2[0-3]):[0-5]\d$"
+
+
+def clock_time(value: Any) -> dt.time:
+    """``"09:30"`` → ``time(9, 30)``; a :class:`datetime.time` passes as it is."""
+    if isinstance(value, dt.time):
+        return value
+    if isinstance(value, str) and re.fullmatch(HHMM_PATTERN, value):
+        hour, minute = (int(part) for part in value.split(":"))
+        return dt.time(hour, minute)
+    raise ValueError("expected a local clock time HH:MM (00:00–23:59)")
+
+
+#: A local clock time from "HH:MM" text.
+ClockTime = Annotated[
+    dt.time,
+    BeforeValidator(clock_time),
+    Field(strict=False),
+    WithJsonSchema({"type": "string", "pattern": HHMM_PATTERN}),
+    PlainSerializer(lambda value: value.strftime("%H:%M"), return_type=str),
+]
 
 #: Standard gravity [m/s²] (CGPM 1901).
 GRAVITY_MPS2 = 9.80665
@@ -590,6 +617,24 @@ class Depot(Params):
     )
 
 
+class TimeWindow(Params):
+    """When a stop takes deliveries, local time on the round's date: service starts inside."""
+
+    start: ClockTime = Field(..., description="Opens, local HH:MM.")
+    end: ClockTime = Field(..., description="Closes, local HH:MM; after start.")
+
+    @field_validator("end")
+    @classmethod
+    def _after_start(cls, value: dt.time, info: ValidationInfo) -> dt.time:
+        if "start" in info.data and value <= info.data["start"]:
+            raise ValueError("end must be after start")
+        return value
+
+
+#: Most time windows of one stop.
+MAX_TIME_WINDOWS = 8
+
+
 class Stop(Depot):
     """A delivery stop."""
 
@@ -599,6 +644,33 @@ class Stop(Depot):
         60.0, ge=0, le=86_400, description="Time the cargo door is open, within the service [s]."
     )
     delivery_kg: float = Field(0.0, ge=0, le=40_000, description="Payload unloaded here [kg].")
+    time_windows: list[TimeWindow] = Field(
+        default_factory=list,
+        max_length=MAX_TIME_WINDOWS,
+        description="When the stop takes deliveries (local time on the round's date), sorted "
+        "and not overlapping: the van may arrive early and wait; service starts inside a "
+        "window. Empty: any time.",
+    )
+
+    @field_validator("time_windows")
+    @classmethod
+    def _windows_in_order(cls, value: list[TimeWindow]) -> list[TimeWindow]:
+        for k in range(1, len(value)):
+            if value[k].start < value[k - 1].end:
+                rule = PydanticCustomError(
+                    "windows_in_order",
+                    "starts at {start}, before window {previous} ends ({end}); windows must be "
+                    "sorted and must not overlap",
+                    {
+                        "start": f"{value[k].start:%H:%M}",
+                        "previous": k - 1,
+                        "end": f"{value[k - 1].end:%H:%M}",
+                    },
+                )
+                raise ValidationError.from_exception_data(
+                    "TimeWindow", [InitErrorDetails(type=rule, loc=(k, "start"), input=None)]
+                )
+        return value
 
     @field_validator("door_open_s")
     @classmethod

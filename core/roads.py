@@ -75,6 +75,29 @@ class RoadRouter(Protocol):
         ...
 
 
+class RememberingRouter:
+    """A road router that asks its inner router once per set of places and once per leg (the
+    cells of a study grid, the verification rounds of a fleet plan drive the same roads)."""
+
+    def __init__(self, inner: RoadRouter) -> None:
+        self.inner = inner
+        self.name = inner.name
+        self._tables: dict[tuple[tuple[float, float], ...], RoadTable] = {}
+        self._routes: dict[tuple[float, float, float, float], LegRoute] = {}
+
+    def table(self, places: Sequence[Depot]) -> RoadTable:
+        key = tuple((p.lat, p.lon) for p in places)
+        if key not in self._tables:
+            self._tables[key] = self.inner.table(places)
+        return self._tables[key]
+
+    def route(self, origin: Depot, destination: Depot) -> LegRoute:
+        key = (origin.lat, origin.lon, destination.lat, destination.lon)
+        if key not in self._routes:
+            self._routes[key] = self.inner.route(origin, destination)
+        return self._routes[key]
+
+
 def bearing_deg(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
     """Initial great-circle bearing from point 1 to point 2 [°, 0 north, 90 east]."""
     phi1, phi2 = np.radians(lat1), np.radians(lat2)

@@ -18,7 +18,6 @@ from core.params import (
     CALM_DRIVER,
     NORMAL_DRIVER,
     STREET_TYPES,
-    Depot,
     IsoDate,
     Location,
     Params,
@@ -27,8 +26,9 @@ from core.params import (
     VanParams,
     Weather,
 )
-from core.plan import PlanProblem, PlanResult, plan
-from core.roads import LegRoute, RoadRouter, RoadTable
+from core.plan import plan
+from core.roads import RememberingRouter, RoadRouter
+from core.round import PlanProblem, PlanResult
 from core.simulate import CONSUMERS, simulate
 from core.weather import WeatherService
 
@@ -156,29 +156,6 @@ DEFAULT_DRIVERS = (CALM_DRIVER, NORMAL_DRIVER, AGGRESSIVE_DRIVER)
 DEFAULT_TRAFFIC = (0.2, 0.8)
 
 
-class _RememberingRouter:
-    """A road router that asks its inner router once per set of places and once per leg: the
-    cells of a grid drive the same roads."""
-
-    def __init__(self, inner: RoadRouter) -> None:
-        self.inner = inner
-        self.name = inner.name
-        self._tables: dict[tuple[tuple[float, float], ...], RoadTable] = {}
-        self._routes: dict[tuple[float, float, float, float], LegRoute] = {}
-
-    def table(self, places: Sequence[Depot]) -> RoadTable:
-        key = tuple((p.lat, p.lon) for p in places)
-        if key not in self._tables:
-            self._tables[key] = self.inner.table(places)
-        return self._tables[key]
-
-    def route(self, origin: Depot, destination: Depot) -> LegRoute:
-        key = (origin.lat, origin.lon, destination.lat, destination.lon)
-        if key not in self._routes:
-            self._routes[key] = self.inner.route(origin, destination)
-        return self._routes[key]
-
-
 def scenario_grid(
     problem: PlanProblem,
     seasons: Sequence[Season] | None = None,
@@ -218,7 +195,7 @@ def scenario_grid(
     ):
         if not axis:
             raise InvalidParameterError(f"{name} must hold at least one value", name)
-    remembering = None if router is None else _RememberingRouter(router)
+    remembering = None if router is None else RememberingRouter(router)
     baseline = plan(problem, remembering, weather_service)
     by_id = {stop.id: stop for stop in problem.stops}
     fixed = problem.model_copy(

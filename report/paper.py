@@ -36,7 +36,8 @@ from core.params import (
     Location,
     Weather,
 )
-from core.plan import PlanProblem, PlanResult, plan
+from core.plan import plan
+from core.round import PlanProblem, PlanResult
 from core.simulate import CONSUMERS, simulate
 from core.studies import Season, scenario_grid, speed_sweep
 

@@ -13,8 +13,10 @@ from starlette.exceptions import HTTPException
 from app.examples import PLAN_EXAMPLE
 from app.jobs.store import IdempotencyConflictError, JobStore, JobView, store_for
 from app.schemas import (
+    FleetPlanRequest,
     JobList,
     JobOut,
+    JobRequest,
     JobStatus,
     JobSubmission,
     JobSummary,
@@ -26,14 +28,18 @@ from app.work import check_job
 from core.exceptions import CoreError
 
 router = APIRouter(prefix="/jobs", tags=["jobs"])
-REQUEST_MODELS: dict[str, type[BaseModel]] = {"plan": PlanRequest, "scenarios": ScenariosRequest}
+REQUEST_MODELS: dict[str, type[BaseModel]] = {
+    "plan": PlanRequest,
+    "fleet-plan": FleetPlanRequest,
+    "scenarios": ScenariosRequest,
+}
 
 
 def job_store(settings: Annotated[Settings, Depends(get_settings)]) -> JobStore:
     return store_for(settings.database_url)
 
 
-def _validated(submission: JobSubmission, settings: Settings) -> PlanRequest | ScenariosRequest:
+def _validated(submission: JobSubmission, settings: Settings) -> JobRequest:
     """The job's request as the synchronous endpoint would validate it, fields named under
     ``request.``."""
     try:
@@ -42,7 +48,7 @@ def _validated(submission: JobSubmission, settings: Settings) -> PlanRequest | S
         raise RequestValidationError(
             [e | {"loc": ("body", "request", *e["loc"])} for e in error.errors()]
         ) from None
-    assert isinstance(request, PlanRequest | ScenariosRequest)
+    assert isinstance(request, PlanRequest | FleetPlanRequest | ScenariosRequest)
     try:
         check_job(submission.type, request, settings)
     except CoreError as error:
@@ -117,7 +123,9 @@ async def create_job(
     has succeeded, its result — exactly what the synchronous endpoint returns."""
     request = _validated(submission, settings)
     time_limit_s = min(
-        request.time_limit_s if isinstance(request, PlanRequest) else request.plan.time_limit_s,
+        request.plan.time_limit_s
+        if isinstance(request, ScenariosRequest)
+        else request.time_limit_s,
         settings.max_job_time_limit_s,
     )
     try:

@@ -11,6 +11,10 @@ from app.schemas import (
     EnergyKwh,
     EnergyShare,
     Feature,
+    FleetPlanResponse,
+    FleetRouteOut,
+    FleetSolverOut,
+    FleetTotals,
     LegOut,
     LineString,
     PlanFeatureCollection,
@@ -19,11 +23,13 @@ from app.schemas import (
     SolverOut,
     StopOut,
     Totals,
+    UnassignedOut,
     WeatherOut,
 )
 from core.battery import BatteryVerdict
+from core.fleet import FleetResult
 from core.params import Weather
-from core.plan import PlanResult
+from core.round import PlanResult
 from core.weather import DayWeather, WeatherSource
 
 #: Credit owed wherever OpenStreetMap data is shown (ODbL 1.0).
@@ -98,6 +104,38 @@ def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanRes
             objective_value=result.objective_value,
             runtime_s=result.solver_runtime_s,
         ),
+        distance_source=result.distance_source,
+        warnings=result.warnings,
+        attribution=OSM_ATTRIBUTION if result.distance_source == "osrm" else None,
+    )
+
+
+def fleet_response(result: FleetResult, include_geometry: bool = False) -> FleetPlanResponse:
+    """The answer of ``POST /v1/fleet-plans``."""
+    return FleetPlanResponse(
+        routes=[
+            FleetRouteOut(
+                **dict(plan_response(route.plan, include_geometry)),
+                vehicle_id=route.vehicle_id,
+            )
+            for route in result.routes
+        ],
+        unassigned=[UnassignedOut(**vars(u)) for u in result.unassigned],
+        totals=FleetTotals(
+            distance_m=result.distance_m,
+            duration_s=result.duration_s,
+            energy_kwh=energy(result.energy_kwh),
+            grid_kwh=result.grid_kwh,
+            vehicles_used=result.vehicles_used,
+        ),
+        solver=FleetSolverOut(
+            status=result.solver_status,
+            objective=result.objective,
+            objective_value=result.objective_value,
+            runtime_s=result.solver_runtime_s,
+            verification_rounds=result.verification_rounds,
+        ),
+        timezone=result.timezone,
         distance_source=result.distance_source,
         warnings=result.warnings,
         attribution=OSM_ATTRIBUTION if result.distance_source == "osrm" else None,

@@ -12,7 +12,7 @@ from pathlib import Path
 import httpx
 import pytest
 
-from app.examples import PLAN_EXAMPLE, SCENARIOS_EXAMPLE
+from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE, SCENARIOS_EXAMPLE
 from benchmarks.common import Server
 from tests.app.serving import alive, children, long_plan
 
@@ -69,9 +69,37 @@ def test_a_scenarios_job(server):
     assert done["status"] == "succeeded" and len(done["result"]["cells"]) == 12
 
 
+def test_a_fleet_plan_job_answers_what_the_endpoint_answers(server):
+    response = submit(server.url, {"type": "fleet-plan", "request": FLEET_PLAN_EXAMPLE})
+    assert response.status_code == 202 and response.json()["type"] == "fleet-plan"
+    done = wait_for(server.url, response.json()["id"])
+    assert done["status"] == "succeeded", done
+    direct = httpx.post(f"{server.url}/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE, timeout=60).json()
+    for answer in (done["result"], direct):
+        answer["solver"].pop("runtime_s")
+        for route in answer["routes"]:
+            route["solver"].pop("runtime_s")
+    assert done["result"] == direct
+
+
 @pytest.mark.parametrize(
     ("body", "field"),
     [
+        (
+            {
+                "type": "fleet-plan",
+                "request": FLEET_PLAN_EXAMPLE
+                | {"vehicles": [FLEET_PLAN_EXAMPLE["vehicles"][0] | {"shift_end": "05:00"}]},
+            },
+            "request.vehicles[0].shift_end",
+        ),
+        (
+            {
+                "type": "fleet-plan",
+                "request": FLEET_PLAN_EXAMPLE | {"vehicles": FLEET_PLAN_EXAMPLE["vehicles"] * 2},
+            },
+            "request.vehicles[2].id",
+        ),
         (
             {"type": "plan", "request": PLAN_EXAMPLE | {"depot": {"lat": 99, "lon": 16}}},
             "request.depot.lat",

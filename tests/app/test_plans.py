@@ -88,7 +88,7 @@ def _stops(n):
             "stops[1].id",
         ),
         ({"vehicle": {"mass_kg": -5}}, "vehicle.mass_kg"),
-        ({"vehicle": {"preset": "tesla-semi"}}, "preset"),
+        ({"vehicle": {"preset": "tesla-semi"}}, "vehicle.preset"),
         ({"vehicle": {"drivetrain_efficiency": 1.5}}, "vehicle.drivetrain_efficiency"),
         ({"cargo_box": {"setpoint_c": 10}}, "cargo_box.product_limit_c"),
         ({"battery": {"initial_soc": 0.1, "min_soc": 0.2}}, "battery.min_soc"),

@@ -226,3 +226,28 @@ def test_scenarios_on_real_roads(roads):
     request = SCENARIOS_EXAMPLE | {"plan": monaco_plan(list(PLACES)[:5])}
     body = roads.post("/v1/studies/scenarios", json=request).json()
     assert len(body["cells"]) == 12 and body["tour"][0] == "moneghetti"
+
+
+def test_a_fleet_on_real_roads_keeps_its_windows_as_driven(roads):
+    # Monaco's roads are slow to drive in the simulation (about twice OSRM's free-flow times):
+    # the windows must hold for the times the simulation drives, not the router's.
+    names = list(PLACES)
+    body = monaco_plan(names)
+    for stop in body["stops"][:4]:
+        stop["time_windows"] = [{"start": "09:20", "end": "09:40"}]
+    body.pop("start_time")
+    body["vehicles"] = [
+        {"id": f"van-{k}", "shift_start": "09:00", "shift_end": "12:00"} for k in range(3)
+    ]
+    answer = roads.post("/v1/fleet-plans", json=body)
+    assert answer.status_code == 200, answer.text
+    fleet = answer.json()
+    assert fleet["distance_source"] == "osrm" and fleet["attribution"]
+    assert fleet["unassigned"] == []
+    windowed = {s["id"] for s in body["stops"][:4]}
+    for route in fleet["routes"]:
+        assert route["battery"]["feasible"] and route["distance_source"] == "osrm"
+        for stop in route["stops"]:
+            if stop["id"] in windowed:
+                assert "09:20:00" <= stop["service_start"][11:19] <= "09:40:00", stop
+        assert route["legs"][-1]["arrive"][11:16] <= "12:00"

@@ -17,7 +17,8 @@ from core.params import (
     VehicleParams,
     Weather,
 )
-from core.plan import PlanProblem, plan
+from core.plan import plan
+from core.round import PlanProblem
 from core.weather import climatology
 
 DEPOT = Depot(id="depot", lat=48.2082, lon=16.3738)
@@ -277,3 +278,41 @@ def test_cab_off_at_stops_saves_winter_energy():
         leg.energy_kwh["cabin"] > on.legs[k].energy_kwh["cabin"]
         for k, leg in enumerate(off.legs[1:], start=1)
     )
+
+
+def test_waiting_for_a_window_is_parked_time_that_costs_energy():
+    # Two stops 2 min apart (client matrix, exact times); the second opens at 10:00. Leaving at
+    # 09:00 the van would wait 48 min at B; it leaves 5 min later instead (A closes at 09:10,
+    # no later): A served 09:10–09:15, B reached at 09:17, 43 min of waiting.
+    stops = [
+        Stop(id="A", lat=48.21, lon=16.37, time_windows=[{"start": "08:00", "end": "09:10"}]),
+        Stop(id="B", lat=48.22, lon=16.37, time_windows=[{"start": "10:00", "end": "11:00"}]),
+    ]
+    matrix = RoadMatrix(
+        distances_m=[[0, 2500, 2500], [2500, 0, 1000], [2500, 1000, 0]],
+        durations_s=[[0, 300, 300], [300, 0, 120], [300, 120, 0]],
+    )
+    common = {"matrix": matrix, "weather": Weather(t_min_c=18, t_max_c=31)}
+    waiting = plan(problem(stops, start_time=dt.time(9, 0), **common))
+    a, b = waiting.stops
+    assert waiting.tour == ["depot", "A", "B", "depot"]
+    assert waiting.legs[0].depart.strftime("%H:%M") == "09:05"
+    assert a.service_start.strftime("%H:%M:%S") == "09:10:00" and a.wait_s == 0
+    assert b.arrival.strftime("%H:%M:%S") == "09:17:00"
+    assert b.service_start.strftime("%H:%M:%S") == "10:00:00" and b.wait_s == 43 * 60
+    # The same stop without a wait: the 43 minutes parked cost auxiliaries and the box.
+    free = [stops[0], Stop(id="B", lat=48.22, lon=16.37)]
+    direct = plan(problem(free, start_time=dt.time(9, 0), keep_order=True, **common))
+    assert direct.stops[1].wait_s == 0
+    extra = waiting.stops[1].energy_kwh["total"] - direct.stops[1].energy_kwh["total"]
+    # Auxiliaries alone draw 0.4 kW (Table 2): at least 0.29 kWh in 43 min.
+    assert extra > 0.4 * 43 / 60
+
+
+def test_a_window_opening_later_lets_the_van_leave_later():
+    # The only stop opens at 10:00, 5 min away: the van leaves at 09:55, not at 09:00.
+    stops = [Stop(id="A", lat=48.21, lon=16.37, time_windows=[{"start": "10:00", "end": "11:00"}])]
+    matrix = RoadMatrix(distances_m=[[0, 2500], [2500, 0]], durations_s=[[0, 300], [300, 0]])
+    result = plan(problem(stops, start_time=dt.time(9, 0), matrix=matrix))
+    assert result.legs[0].depart.strftime("%H:%M") == "09:55"
+    assert result.stops[0].wait_s == 0

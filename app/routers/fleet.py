@@ -1,0 +1,52 @@
+"""POST /v1/fleet-plans: the day's stops across several vans, every route simulated."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Body, Depends, Request
+
+from app import work
+from app.examples import FLEET_PLAN_EXAMPLE
+from app.execution import Executor
+from app.routers.plans import executor
+from app.routers.results import fleet_response
+from app.schemas import FleetPlanRequest, FleetPlanResponse
+from app.settings import Settings, get_settings
+
+router = APIRouter(tags=["fleet"])
+
+
+@router.post(
+    "/fleet-plans",
+    operation_id="createFleetPlan",
+    summary="Plan the day's stops across a fleet of vans",
+    response_model=FleetPlanResponse,
+)
+async def create_fleet_plan(
+    request: Annotated[
+        FleetPlanRequest,
+        Body(
+            openapi_examples={
+                "vienna-two-vans": {
+                    "summary": "Two vans, shop receiving windows, a summer day in Vienna",
+                    "value": FLEET_PLAN_EXAMPLE,
+                }
+            }
+        ),
+    ],
+    http: Request,
+    settings: Annotated[Settings, Depends(get_settings)],
+    pool: Annotated[Executor, Depends(executor)],
+) -> FleetPlanResponse:
+    """Splits the stops across the vans (OR-Tools routing with time windows, shifts, payload
+    and each van's battery as constraints) and simulates every route's day in full: the charge
+    never falls below a van's reserve, service starts inside a window, every van is back
+    before its shift ends, deliveries fit the payload. A route the simulation rejects is
+    tightened and solved again within `time_limit_s`; stops no van can serve are listed in
+    `unassigned` with their reason. Solved in a worker process, as plans are."""
+    result = await pool.run(
+        work.run_fleet_plan, request, settings, disconnected=http.is_disconnected
+    )
+    http.app.state.metrics.solve.observe(result.solver_runtime_s)
+    return fleet_response(result, request.include_geometry)
