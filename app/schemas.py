@@ -22,6 +22,7 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from core.exceptions import InvalidParameterError
 from core.fleet import MAX_VEHICLES, UnassignedReason, shift_in_order
+from core.geo import DistanceSource
 from core.params import (
     DEFAULT_PRESET,
     HHMM_PATTERN,
@@ -437,6 +438,19 @@ class SolverOut(ApiModel):
     runtime_s: float = Field(..., description="Time the tour search took [s].")
 
 
+#: Where an answer's distances came from, and the credit owed for its map data.
+DistanceSourceOut = Annotated[
+    DistanceSource,
+    Field(
+        description="Where the legs' distances and durations came from: the OSRM router, the "
+        "request's matrix, or the great-circle estimate."
+    ),
+]
+AttributionOut = Annotated[
+    str | None, Field(description="Credit for the map data the legs were routed on.")
+]
+
+
 class PlanResponse(ApiModel):
     """The planned and simulated round."""
 
@@ -449,19 +463,13 @@ class PlanResponse(ApiModel):
     timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
     box: BoxOut = Field(..., description="Cargo-box temperatures (dynamic mode).")
     solver: SolverOut = Field(..., description="How the tour search ended.")
-    distance_source: Literal["osrm", "client", "estimate"] = Field(
-        ...,
-        description="Where the legs' distances and durations came from: the OSRM router, the "
-        "request's matrix, or the great-circle estimate.",
-    )
+    distance_source: DistanceSourceOut
     warnings: list[str] = Field(
         default_factory=list,
         description="What the plan had to do without (e.g. the weather service was down and "
         "the climatology was used).",
     )
-    attribution: str | None = Field(
-        None, description="Credit for the map data the legs were routed on."
-    )
+    attribution: AttributionOut = None
 
 
 class FleetVehicleRequest(VanRequest):
@@ -568,17 +576,11 @@ class FleetPlanResponse(ApiModel):
     totals: FleetTotals = Field(..., description="Every route together.")
     solver: FleetSolverOut = Field(..., description="How the search ended.")
     timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
-    distance_source: Literal["osrm", "client", "estimate"] = Field(
-        ...,
-        description="Where the legs' distances and durations came from: the OSRM router, the "
-        "request's matrix, or the great-circle estimate.",
-    )
+    distance_source: DistanceSourceOut
     warnings: list[str] = Field(
         default_factory=list, description="What the plan had to do without."
     )
-    attribution: str | None = Field(
-        None, description="Credit for the map data the legs were routed on."
-    )
+    attribution: AttributionOut = None
 
 
 class Feature(ApiModel):

@@ -21,6 +21,7 @@ from app.schemas import (
     JobType,
     PlanRequest,
     PowerSeries,
+    RoundRequest,
     ScenarioCellOut,
     ScenariosRequest,
     ScenariosResponse,
@@ -47,38 +48,41 @@ from core.weather import forecast_for
 MIN_DISTANCE_FOR_PER_KM_M = 1.0
 
 
-def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
-    """The core problem of a plan request, within the server's limits."""
+def _round_fields(request: RoundRequest, settings: Settings) -> dict[str, Any]:
+    """What a plan and a fleet plan pass alike to the core, within the server's limits."""
     if len(request.stops) > settings.max_stops:
         raise LimitExceededError(
             f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
             "stops",
         )
+    return {
+        "date": request.date,
+        "timezone": request.timezone,
+        "depot": request.depot,
+        "stops": request.stops,
+        "weather": request.weather,
+        "driver_aggressiveness": request.driver_aggressiveness,
+        "traffic_density": request.traffic_density,
+        "objective": request.objective,
+        "matrix": request.matrix,
+        "time_limit_s": min(request.time_limit_s, settings.max_time_limit_s),
+    }
+
+
+def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
+    """The core problem of a plan request, within the server's limits."""
     return PlanProblem(
-        date=request.date,
+        **_round_fields(request, settings),
         start_time=clock_time(request.start_time),
-        timezone=request.timezone,
-        depot=request.depot,
-        stops=request.stops,
         van=request.van(),
-        weather=request.weather,
-        driver_aggressiveness=request.driver_aggressiveness,
-        traffic_density=request.traffic_density,
-        objective=request.objective,
-        matrix=request.matrix,
         keep_order=request.keep_order,
-        time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
     )
 
 
 def fleet_problem(request: FleetPlanRequest, settings: Settings) -> FleetProblem:
     """The core problem of a fleet plan request, within the server's limits; a van's own
     errors name it (``vehicles[1].battery.min_soc``)."""
-    if len(request.stops) > settings.max_stops:
-        raise LimitExceededError(
-            f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
-            "stops",
-        )
+    fields = _round_fields(request, settings)
     vehicles = []
     for index, vehicle in enumerate(request.vehicles):
         try:
@@ -94,20 +98,7 @@ def fleet_problem(request: FleetPlanRequest, settings: Settings) -> FleetProblem
                 shift_end=vehicle.shift_end,
             )
         )
-    return FleetProblem(
-        date=request.date,
-        timezone=request.timezone,
-        depot=request.depot,
-        vehicles=vehicles,
-        stops=request.stops,
-        objective=request.objective,
-        minimize_vehicles=request.minimize_vehicles,
-        weather=request.weather,
-        driver_aggressiveness=request.driver_aggressiveness,
-        traffic_density=request.traffic_density,
-        matrix=request.matrix,
-        time_limit_s=min(request.time_limit_s, settings.max_time_limit_s),
-    )
+    return FleetProblem(**fields, vehicles=vehicles, minimize_vehicles=request.minimize_vehicles)
 
 
 def run_fleet_plan(request: FleetPlanRequest, settings: Settings) -> FleetResult:

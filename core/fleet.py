@@ -73,7 +73,7 @@ UnassignedReason = Literal["time_window", "capacity", "battery", "shift", "unrea
 #: Most vans in one fleet plan.
 MAX_VEHICLES = 100
 #: Share of the remaining budget one solve may take (the rest verifies and re-solves).
-_SOLVE_SHARE = 0.8
+_SOLVE_SHARE = 0.9
 #: Budget below which no new solve starts [s].
 _MIN_SOLVE_S = 0.05
 #: A tightened energy budget is cut this much below the simulated need, so the next
@@ -250,7 +250,7 @@ def plan_fleet(
     def weather_for(begin: dt.datetime, span_s: float) -> tuple[Forecast | None, list[str]]:
         return day_weather, day_warnings
 
-    routed = route_vans(
+    routed = FleetSolver(
         shifts,
         places,
         legs,
@@ -258,8 +258,7 @@ def plan_fleet(
         None if router is None else RememberingRouter(router),
         weather_for,
         energy_budget=True,
-        minimize_vehicles=problem.minimize_vehicles,
-    )
+    ).run(problem.minimize_vehicles)
     plans = [route.plan for route in routed.routes]
     energy = {name: sum(p.energy_kwh[name] for p in plans) for name in (*CONSUMERS, "total")}
     return FleetResult(
@@ -350,18 +349,9 @@ class _Failure:
     detail: str
 
 
-def route_vans(
-    shifts: list[VanShift],
-    places: list[Depot],
-    legs: Legs,
-    timezone_name: str,
-    router: RoadRouter | None,
-    weather_for: WeatherFor,
-    *,
-    energy_budget: bool,
-    minimize_vehicles: bool,
-) -> Routed:
-    """Routes for the vans, each verified by the simulation of its day (see the module).
+class FleetSolver:
+    """Routes for the vans, each verified by the simulation of its day: solve, verify, tighten,
+    solve again (see the module).
 
     Parameters
     ----------
@@ -369,22 +359,16 @@ def route_vans(
         The vans; their problems share the depot, the stops, the date and the conditions.
     places, legs
         The depot then the stops, and every ordered pair's leg.
+    timezone_name
+        The zone's name, for the answers.
     router
         For the roads of the legs driven (OSRM), or None.
     weather_for
         The weather for a span of the day.
     energy_budget
-        Whether the battery is a constraint (fleet) or only reported (one round).
-    minimize_vehicles
-        Fewer vans first, then the objective.
+        Whether the battery and the payload are constraints (a fleet) or only reported (one
+        round, whose payload is checked beforehand).
     """
-    return _Engine(shifts, places, legs, timezone_name, router, weather_for, energy_budget).run(
-        minimize_vehicles
-    )
-
-
-class _Engine:
-    """Solve, verify by simulation, tighten, solve again (module docstring)."""
 
     def __init__(
         self,
@@ -394,6 +378,7 @@ class _Engine:
         timezone_name: str,
         router: RoadRouter | None,
         weather_for: WeatherFor,
+        *,
         energy_budget: bool,
     ) -> None:
         self.started = time.perf_counter()
@@ -585,6 +570,8 @@ class _Engine:
     # --- one pass ------------------------------------------------------------------------
 
     def run(self, minimize_vehicles: bool) -> Routed:
+        """Solve and verify until every route holds or the time limit; ``minimize_vehicles``:
+        fewer vans first, then the objective."""
         routes: list[list[int]] = [[] for _ in self.shifts]
         results: dict[int, PlanResult] = {}
         failures: dict[int, _Failure] = {}

@@ -13,7 +13,7 @@ import datetime as dt
 
 from core.clock import check_representable, departure
 from core.exceptions import InvalidStopsError, LimitExceededError, NoRouteError
-from core.fleet import VanShift, route_vans
+from core.fleet import FleetSolver, VanShift
 from core.geo import Legs, build_legs
 from core.params import Depot
 from core.roads import RememberingRouter, RoadRouter
@@ -118,7 +118,7 @@ def _in_windows(
 ) -> PlanResult:
     """The round when stops have time windows: the routing solver with this one van, every
     stop required; a stop no order serves in time is an error naming it."""
-    routed = route_vans(
+    routed = FleetSolver(
         [VanShift(id="van", problem=problem, start=start, end=None)],
         places,
         legs,
@@ -126,8 +126,7 @@ def _in_windows(
         None if router is None else RememberingRouter(router),
         weather_for,
         energy_budget=False,
-        minimize_vehicles=False,
-    )
+    ).run(minimize_vehicles=False)
     if routed.unassigned:
         first = routed.unassigned[0]
         index = next(k for k, stop in enumerate(problem.stops) if stop.id == first.id)
