@@ -8,7 +8,6 @@ import signal
 import time
 
 import httpx
-import numpy as np
 import pytest
 
 from benchmarks.common import Server
@@ -40,7 +39,9 @@ def test_liveness_answers_while_every_worker_solves(server):
             time.sleep(0.02)
         assert [f.result().status_code for f in solving] == [200, 200]
     assert len(latencies) > 50
-    assert np.percentile(latencies, 99) < 0.1
+    # Answered while the solves run, not after them: a blocked event loop would hold the probes
+    # for seconds (each solve takes 6 s). How fast exactly is bench_serving's figure.
+    assert max(latencies) < 1.0
 
 
 @pytest.mark.parametrize(
