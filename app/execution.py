@@ -34,6 +34,7 @@ from typing import Any, TypeVar
 from pebble import ProcessExpired, ProcessPool
 
 from app.settings import Settings
+from core.arrays import keep_heap
 
 T = TypeVar("T")
 #: Nice increment of the workers: the server's event loop comes first on a busy machine.
@@ -68,6 +69,7 @@ def _watch_parent(parent_pid: int) -> None:
 
 
 def _initialize_worker(parent_pid: int) -> None:
+    keep_heap()
     with contextlib.suppress(OSError):  # not permitted: keep the default priority
         os.nice(WORKER_NICENESS)
     # Stopping a worker must be instant even inside OR-Tools' C++ search (a Python-level

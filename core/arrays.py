@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ctypes
 import math
 from typing import Any
 
@@ -9,6 +10,33 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.floating[Any]]
+
+#: Freed memory a process keeps at the top of its heap with :func:`keep_heap` [B].
+HEAP_KEEP_BYTES = 64 << 20
+#: ``M_TRIM_THRESHOLD`` of glibc's ``mallopt`` (malloc.h).
+_M_TRIM_THRESHOLD = -1
+
+
+def keep_heap(keep_bytes: int = HEAP_KEEP_BYTES) -> bool:
+    """Have the C library keep up to ``keep_bytes`` of freed memory at the top of the heap.
+
+    glibc gives the top of the heap back to the system as soon as 128 kB lie free there, so
+    each of a simulation's per-second arrays (115 kB for a 4 h round at 1 Hz) is faulted in
+    anew every time numpy allocates one: about 40 % of a simulation's time (``make bench``;
+    numpy/numpy#8783 describes the effect). The service's worker processes call this at
+    start; a program that runs many simulations in its own process may too. The core itself
+    never calls it (it changes the whole process).
+
+    Returns
+    -------
+    bool
+        Whether the allocator took the setting (False where the C library is not glibc).
+    """
+    try:
+        mallopt = ctypes.CDLL(None).mallopt  # the C library the interpreter runs on
+    except AttributeError:
+        return False
+    return bool(mallopt(_M_TRIM_THRESHOLD, keep_bytes))
 
 
 def reflected_cumsum(increments: ArrayLike, initial: float = 0.0) -> FloatArray:
