@@ -65,9 +65,10 @@ class RoadRouter(Protocol):
     name: str
 
     def table(self, places: Sequence[Depot]) -> RoadTable:
-        """Distances and durations of every ordered pair; raises
+        """Distances and durations of every ordered pair, NaN where no road leads; raises
         :class:`core.exceptions.ServiceUnavailableError` when the router fails and
-        :class:`core.exceptions.InvalidStopsError` naming a stop it cannot use."""
+        :class:`core.exceptions.InvalidStopsError` naming a stop it cannot use (too far from
+        any road)."""
         ...
 
     def route(self, origin: Depot, destination: Depot) -> LegRoute:

@@ -73,15 +73,21 @@ def install() -> Path:
     return BIN
 
 
+#: The extract formats osrm-extract reads; it names its output after the name without them.
+EXTRACT_SUFFIXES = (".osm.pbf", ".osm.bz2", ".osm", ".pbf")
+
+
 def prepare(pbf: Path, out_dir: Path | None = None) -> Path:
-    """Extract, partition and customize ``pbf`` with the car profile (MLD); the .osrm base."""
+    """Extract, partition and customize an OpenStreetMap extract (``.osm.pbf``, ``.osm.bz2``
+    or ``.osm``) with the car profile (MLD); the .osrm base."""
     install()
     out_dir = out_dir or pbf.parent
     out_dir.mkdir(parents=True, exist_ok=True)
     source = out_dir / pbf.name
     if source.resolve() != pbf.resolve():
         shutil.copyfile(pbf, source)
-    base = out_dir / (pbf.name.removesuffix(".osm.pbf").removesuffix(".pbf") + ".osrm")
+    suffix = next((s for s in EXTRACT_SUFFIXES if pbf.name.endswith(s)), "")
+    base = out_dir / (pbf.name.removesuffix(suffix) + ".osrm")
     quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
     subprocess.run([BIN / "osrm-extract", "-p", PROFILES / "car.lua", source], check=True, **quiet)
     subprocess.run([BIN / "osrm-partition", base], check=True, **quiet)
@@ -142,7 +148,9 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(prog="python -m tools.osrm", description=__doc__)
     commands = parser.add_subparsers(dest="command", required=True)
     commands.add_parser("install", help="fetch the OSRM programs into .osrm/")
-    prep = commands.add_parser("prepare", help="extract, partition, customize a .osm.pbf")
+    prep = commands.add_parser(
+        "prepare", help="extract, partition, customize a .osm.pbf, .osm.bz2 or .osm"
+    )
     prep.add_argument("pbf", type=Path)
     prep.add_argument("--out", type=Path, default=None, help="folder (default: beside the pbf)")
     serve = commands.add_parser("serve", help="run osrm-routed on 127.0.0.1")

@@ -107,14 +107,8 @@ class OsrmRouter:
                 f"the nearest road; at most {self.max_snap_m:g} m is accepted",
                 _field(k),
             )
-        missing = ~np.isfinite(distance) | ~np.isfinite(duration)
-        np.fill_diagonal(missing, False)
-        if missing.any():
-            # The place cut off from most others is the one to name.
-            k = int(np.argmax(missing.sum(axis=0) + missing.sum(axis=1)))
-            raise InvalidStopsError(
-                f"no road connects '{places[k].id}' with the other places of the round", _field(k)
-            )
+        # A pair with no road stays NaN (OSRM's null): a plan names the stop, a fleet plan
+        # leaves it out as unreachable.
         np.fill_diagonal(distance, 0.0)
         np.fill_diagonal(duration, 0.0)
         return RoadTable(distance, duration, snap)

@@ -15,7 +15,9 @@ from app.connectors.osrm import OsrmRouter
 from app.examples import SCENARIOS_EXAMPLE
 from app.main import create_app
 from app.settings import Settings
+from core.exceptions import NoRouteError
 from core.params import Depot
+from core.round import leg_routes
 from tools import osrm
 
 PLACES = {
@@ -149,6 +151,77 @@ def test_a_stop_in_the_sea_is_named(roads):
     assert response.status_code == 422
     error = response.json()["errors"][0]
     assert error["field"] == "stops[2]" and "nearest road" in error["message"]
+
+
+# Two road islands 3 km apart with no road between them, as OpenStreetMap XML (osrm-extract
+# reads .osm as well as .osm.pbf).
+ISLANDS_OSM = """<?xml version="1.0" encoding="UTF-8"?>
+<osm version="0.6" generator="coldroute-tests">
+  <node id="1" version="1" lat="43.7300" lon="7.4000"/>
+  <node id="2" version="1" lat="43.7300" lon="7.4040"/>
+  <node id="3" version="1" lat="43.7300" lon="7.4080"/>
+  <node id="4" version="1" lat="43.7300" lon="7.4120"/>
+  <node id="11" version="1" lat="43.7500" lon="7.4400"/>
+  <node id="12" version="1" lat="43.7500" lon="7.4440"/>
+  <node id="13" version="1" lat="43.7500" lon="7.4480"/>
+  <way id="100" version="1">
+    <nd ref="1"/><nd ref="2"/><nd ref="3"/><nd ref="4"/><tag k="highway" v="residential"/>
+  </way>
+  <way id="200" version="1">
+    <nd ref="11"/><nd ref="12"/><nd ref="13"/><tag k="highway" v="residential"/>
+  </way>
+</osm>
+"""
+ISLAND_A = [("depot", 43.7300, 7.4020), ("west", 43.7300, 7.4080)]
+ISLAND_B = ("island", 43.7500, 7.4450)
+
+
+@pytest.fixture(scope="module")
+def islands_url(tmp_path_factory):
+    """A real osrm-routed on the two islands."""
+    folder = tmp_path_factory.mktemp("islands")
+    (folder / "islands.osm").write_text(ISLANDS_OSM)
+    with osrm.running(osrm.prepare(folder / "islands.osm")) as url:
+        yield url
+
+
+def island_places():
+    return [Depot(id=n, lat=lat, lon=lon) for n, lat, lon in [*ISLAND_A, ISLAND_B]]
+
+
+def test_a_stop_no_road_reaches_is_named(islands_url):
+    (depot, *stops) = [p.model_dump() for p in island_places()]
+    body = {"date": "2026-07-15", "timezone": "Europe/Monaco", "depot": depot, "stops": stops}
+    response = client_for(islands_url).post("/v1/plans", json=body)
+    assert response.status_code == 422
+    error = response.json()["errors"][0]
+    assert error["field"] == "stops[1]" and "no road" in error["message"]
+
+
+def test_a_fleet_leaves_out_a_stop_no_road_reaches(islands_url):
+    (depot, *stops) = [p.model_dump() for p in island_places()]
+    body = {
+        "date": "2026-07-15",
+        "timezone": "Europe/Monaco",
+        "depot": depot,
+        "stops": stops,
+        "vehicles": [{"id": "van"}],
+    }
+    response = client_for(islands_url).post("/v1/fleet-plans", json=body)
+    assert response.status_code == 200
+    answer = response.json()
+    assert [(u["id"], u["reason"]) for u in answer["unassigned"]] == [("island", "unreachable")]
+    assert answer["routes"][0]["tour"] == ["depot", "west", "depot"]
+
+
+def test_osrm_no_route_between_islands_is_named_by_its_destination(islands_url):
+    router = OsrmRouter(islands_url, 5, 100, 500)
+    table = router.table(island_places())
+    assert np.isnan(table.distance_m[0, 2]) and np.isnan(table.duration_s[2, 1])
+    assert table.distance_m[0, 1] > 0
+    with pytest.raises(NoRouteError) as caught:
+        leg_routes(router, island_places(), [0, 1, 2, 0])
+    assert caught.value.field == "stops[1]"
 
 
 def test_a_stopped_router_is_a_503_naming_it(monaco_osrm):
