@@ -147,7 +147,7 @@ def running(base: Path, max_table_size: int = 100) -> Iterator[str]:
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(prog="python -m tools.osrm", description=__doc__)
     commands = parser.add_subparsers(dest="command", required=True)
-    commands.add_parser("install", help="fetch the OSRM programs into .osrm/")
+    commands.add_parser("install", help="fetch the OSRM programs into .router/")
     prep = commands.add_parser(
         "prepare", help="extract, partition, customize a .osm.pbf, .osm.bz2 or .osm"
     )
