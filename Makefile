@@ -20,6 +20,7 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check core app tests benchmarks tools report
 	$(BIN)/mypy core app report
+	$(BIN)/lint-imports
 
 # The OSRM programs from the pinned osrm-bindings wheel (tests run a real router on Monaco).
 $(OSRM): | $(STAMP)

@@ -128,21 +128,17 @@ def record() -> dict[str, Any]:
     them to app/response_examples.json, which Swagger shows)."""
     import datetime as dt
 
-    from app import work
-    from app.routers.results import fleet_response, plan_response
-    from app.schemas import (
-        FleetPlanRequest,
-        JobOut,
-        PlanRequest,
-        ScenariosRequest,
-        SimulateRequest,
-        SpeedSweepRequest,
-    )
+    from app.jobs.schemas import JobOut
+    from app.operations import fleet_plan, plan, simulate, studies
+    from app.schemas.fleet import FleetPlanRequest
+    from app.schemas.plans import PlanRequest
+    from app.schemas.simulate import SimulateRequest
+    from app.schemas.studies import ScenariosRequest, SpeedSweepRequest
     from app.settings import Settings
 
     settings = Settings()
-    plan = plan_response(work.run_plan(PlanRequest.model_validate(PLAN_EXAMPLE), settings))
-    plan_json = plan.model_dump(mode="json")
+    planned = plan.plan_response(plan.run_plan(PlanRequest.model_validate(PLAN_EXAMPLE), settings))
+    plan_json = planned.model_dump(mode="json")
     accepted = dt.datetime(2026, 7, 14, 22, 0, 3, tzinfo=dt.UTC)
     job = JobOut(
         id="6f1c2a9e-4b7d-4e0a-9a51-2f7f3c1d8e20",
@@ -152,20 +148,20 @@ def record() -> dict[str, Any]:
         started_at=accepted + dt.timedelta(seconds=0.4),
         finished_at=accepted + dt.timedelta(seconds=0.5),
         attempts=1,
-        result=plan,
+        result=planned,
     )
     return {
         "plan": plan_json,
-        "fleet_plan": fleet_response(
-            work.run_fleet_plan(FleetPlanRequest.model_validate(FLEET_PLAN_EXAMPLE), settings)
+        "fleet_plan": fleet_plan.fleet_response(
+            fleet_plan.run_fleet_plan(FleetPlanRequest.model_validate(FLEET_PLAN_EXAMPLE), settings)
         ).model_dump(mode="json"),
-        "simulate": work.simulate_trace(
+        "simulate": simulate.simulate_trace(
             SimulateRequest.model_validate(SIMULATE_EXAMPLE), settings
         ).model_dump(mode="json"),
-        "speed_sweep": work.sweep_speeds(
+        "speed_sweep": studies.sweep_speeds(
             SpeedSweepRequest.model_validate(SPEED_SWEEP_EXAMPLE), settings
         ).model_dump(mode="json"),
-        "scenarios": work.run_scenarios(
+        "scenarios": studies.run_scenarios(
             ScenariosRequest.model_validate(SCENARIOS_EXAMPLE), settings
         ).model_dump(mode="json"),
         "job": job.model_dump(mode="json"),

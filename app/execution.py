@@ -76,51 +76,78 @@ def _initialize_worker(parent_pid: int) -> None:
     # handler would only run when the search returns): the operating system's default.
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True).start()
-    import app.work  # noqa: F401  (the first request should not pay for the imports)
 
 
-def _ping() -> int:
+def ping() -> int:
+    """A worker's process id: what a warm-up runs when it is given nothing to load."""
     return os.getpid()
 
 
-_POOLS: dict[int, ProcessPool] = {}
+class WorkerPool:
+    """``workers`` spawned worker processes (Pebble), niced, started on first use.
 
+    Parameters
+    ----------
+    workers
+        How many processes.
+    """
 
-def worker_pool(workers: int) -> ProcessPool:
-    """The process's pool of ``workers`` spawned processes (one per process and size)."""
-    if workers not in _POOLS:
-        _POOLS[workers] = ProcessPool(
-            max_workers=workers,
-            context=multiprocessing.get_context("spawn"),
-            initializer=_initialize_worker,
-            initargs=(os.getpid(),),
-        )
-    return _POOLS[workers]
+    def __init__(self, workers: int) -> None:
+        self.workers = workers
+        self._pool: ProcessPool | None = None
 
+    @property
+    def _processes(self) -> ProcessPool:
+        if self._pool is None:
+            self._pool = ProcessPool(
+                max_workers=self.workers,
+                context=multiprocessing.get_context("spawn"),
+                initializer=_initialize_worker,
+                initargs=(os.getpid(),),
+            )
+        return self._pool
 
-def stop_pools() -> None:
-    """Stop every worker pool of this process now (its threads would keep it alive)."""
-    while _POOLS:
-        _, pool = _POOLS.popitem()
-        pool.stop()  # type: ignore[no-untyped-call]
-        pool.join(timeout=0.5)
+    def schedule(
+        self, fn: Callable[..., T], args: tuple[Any, ...], timeout_s: float | None = None
+    ) -> Future[T]:
+        """Run ``fn(*args)`` in a worker; its future, which ``cancel()`` stops (Pebble
+        terminates the process) and which fails with ``TimeoutError`` after ``timeout_s``."""
+        future: Future[T] = self._processes.schedule(fn, args=args, timeout=timeout_s)
+        return future
+
+    def warm(self, load: Callable[[], object] = ping) -> None:
+        """Start every process and have it run ``load`` (about 2 s, once): a worker that
+        unpickles a function imports its module, so the first request does not pay for it."""
+        for future in [self.schedule(load, ()) for _ in range(self.workers)]:
+            future.result()
+
+    @property
+    def active(self) -> bool:
+        """Whether the processes run and take work."""
+        return self._pool is not None and bool(self._pool.active)
+
+    def stop(self) -> None:
+        """Stop the processes now (the pool's threads would keep the process alive)."""
+        if self._pool is not None:
+            self._pool.stop()  # type: ignore[no-untyped-call]
+            self._pool.join(timeout=0.5)
+            self._pool = None
 
 
 class Executor:
     """The worker pool of one server and the queue in front of it."""
 
-    def __init__(self, settings: Settings) -> None:
+    def __init__(self, settings: Settings, load: Callable[[], object] = ping) -> None:
         self.settings = settings
+        self.load = load
         self.waiting = 0
         self.running = 0
         self.draining = False
         self._free: asyncio.Semaphore | None = None
         self._underway: set[Future[Any]] = set()
         self._stopped = False
-
-    @property
-    def pool(self) -> ProcessPool:
-        return worker_pool(self.settings.workers)
+        self._draining: asyncio.Task[None] | None = None
+        self.pool = WorkerPool(settings.workers)
 
     def _slots(self) -> asyncio.Semaphore:
         if self._free is None:
@@ -128,13 +155,13 @@ class Executor:
         return self._free
 
     async def warm_up(self) -> None:
-        """Start every worker and have it import the code (about 2 s, once)."""
-        futures = [self.pool.schedule(_ping) for _ in range(self.settings.workers)]
-        await asyncio.gather(*(asyncio.wrap_future(f) for f in futures))
+        """Start every worker and have it import the work (``load``'s module; about 2 s,
+        once)."""
+        await asyncio.to_thread(self.pool.warm, self.load)
 
     def alive(self) -> bool:
         """Whether the pool runs and takes work."""
-        return not self._stopped and bool(self.pool.active)
+        return not self._stopped and self.pool.active
 
     async def run(
         self,
@@ -202,7 +229,7 @@ class Executor:
             raise UnavailableError("the server is shutting down", 1)
 
     def _schedule(self, fn: Callable[..., T], args: tuple[Any, ...]) -> Future[T]:
-        future: Future[T] = self.pool.schedule(fn, args=args)
+        future = self.pool.schedule(fn, args)
         self.running += 1
         self._underway.add(future)
 
@@ -225,10 +252,19 @@ class Executor:
         except FutureTimeoutError:
             raise UnavailableError("the worker did not finish in time", 1) from None
 
-    async def drain(self) -> None:
+    def begin_drain(self) -> asyncio.Task[None]:
         """SIGTERM: refuse new work at once, let running work finish within the grace, then
-        stop the workers (their requests are answered 503)."""
-        self.draining = True
+        stop the workers (their requests are answered 503); the drain, begun once."""
+        if self._draining is None:
+            self.draining = True
+            self._draining = asyncio.get_running_loop().create_task(self._drain())
+        return self._draining
+
+    async def drain(self) -> None:
+        """Drain (:meth:`begin_drain`) and wait until the workers have stopped."""
+        await self.begin_drain()
+
+    async def _drain(self) -> None:
         deadline = time.monotonic() + self.settings.shutdown_grace_s
         while self._underway and time.monotonic() < deadline:
             await asyncio.sleep(_POLL_S)
@@ -241,4 +277,4 @@ class Executor:
         """Stop the workers now."""
         if not self._stopped:
             self._stopped = True
-            stop_pools()
+            self.pool.stop()

@@ -6,7 +6,6 @@ import asyncio
 import json
 import logging
 import re
-import secrets
 import signal
 import threading
 import time
@@ -15,22 +14,25 @@ from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from contextvars import ContextVar
 from importlib.metadata import version
-from typing import Annotated, Any
+from typing import Any
 
-from fastapi import APIRouter, Depends, FastAPI, HTTPException, Request, Response
+from fastapi import APIRouter, Depends, FastAPI, HTTPException, Response
 from fastapi.middleware.cors import CORSMiddleware
 from fastapi_offline import FastAPIOffline
 from prometheus_client import CONTENT_TYPE_LATEST, generate_latest
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from app import errors, openapi_doc
+from app.deps import require_api_key
 from app.execution import Executor
-from app.jobs.runner import CeleryDispatcher, LocalRunner
+from app.jobs.dispatch import CeleryDispatcher
+from app.jobs.local import LocalRunner
 from app.jobs.store import store_for
 from app.metrics import Metrics
+from app.operations.kinds import loaded
 from app.routers import fleet, health, jobs, plans, presets, simulate, studies
 from app.routes import RouteTemplates
-from app.schemas import PlanFeatureCollection
+from app.schemas.plans import PlanFeatureCollection
 from app.settings import Settings, get_settings
 
 _log = logging.getLogger("coldroute.requests")
@@ -184,20 +186,6 @@ class RequestContext:
             REQUEST_ID.reset(token)
 
 
-def require_api_key(settings: Annotated[Settings, Depends(get_settings)], request: Request) -> None:
-    """401 unless the request carries the configured key (no key configured: open). The key
-    is a security scheme in the OpenAPI document (app.openapi_doc), not a parameter."""
-    if settings.api_key is None:
-        return
-    x_api_key = request.headers.get("x-api-key")
-    expected = settings.api_key.get_secret_value().encode()
-    # Bytes: compare_digest refuses non-ASCII text, and any key a client sends is just wrong.
-    if x_api_key is None or not secrets.compare_digest(x_api_key.encode(), expected):
-        raise HTTPException(
-            401, "missing or wrong X-API-Key", headers={"WWW-Authenticate": "ApiKey"}
-        )
-
-
 DOCS_PATHS = frozenset({"/docs", "/redoc"})
 # The docs pages may load only what the service itself serves: ReDoc's attribution logo would
 # otherwise be fetched from a CDN, which a dispatcher's offline network cannot reach.
@@ -265,18 +253,12 @@ def _drain_on_signals(executor: Executor) -> None:
     if threading.current_thread() is not threading.main_thread():
         return  # only the main thread may set handlers (tests run the app elsewhere)
     loop = asyncio.get_running_loop()
-    tasks: set[asyncio.Task[None]] = set()
-
-    def start() -> None:
-        if not executor.draining:
-            task = loop.create_task(executor.drain())
-            tasks.add(task)
 
     for number in (signal.SIGTERM, signal.SIGINT):
         previous = signal.getsignal(number)
 
         def handler(signum: int, frame: Any, previous: Any = previous) -> None:
-            loop.call_soon_threadsafe(start)
+            loop.call_soon_threadsafe(executor.begin_drain)
             if callable(previous):
                 previous(signum, frame)
 
@@ -290,11 +272,11 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     _drain_on_signals(executor)
     store = store_for(settings.database_url)
     await asyncio.to_thread(store.migrate)
-    runner = (
-        CeleryDispatcher(store, settings)
-        if settings.broker_url is not None
-        else LocalRunner(store, executor, settings)
-    )
+    runner: LocalRunner | CeleryDispatcher
+    if settings.broker_url is None:
+        runner = LocalRunner(store, executor, settings)
+    else:
+        runner = CeleryDispatcher(store, settings)
     runner.start()
     app.state.runner = runner
     await executor.warm_up()
@@ -303,8 +285,9 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     finally:
         await runner.stop()
         app.state.runner = None
-        if executor.draining:
-            executor.stop()
+        # Runs under way get the grace (a shutdown began it, or begins it now), then the
+        # workers stop.
+        await executor.drain()
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
@@ -324,7 +307,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.dependency_overrides[get_settings] = lambda: settings
     app.state.settings = settings
-    executor = Executor(settings)
+    executor = Executor(settings, load=loaded)
     app.state.executor = executor
     app.state.runner = None
     metrics = Metrics()

@@ -12,10 +12,10 @@ from pyvrp import Model
 from pyvrp.stop import MaxRuntime
 
 from benchmarks.common import REFERENCE, print_table
-from core.fleet import FleetProblem, FleetResult, FleetVehicle, plan_fleet
 from core.params import PRESETS, BatteryParams, Depot, RoadMatrix, Stop, TimeWindow, Weather
-from core.plan import plan
-from core.round import PlanProblem
+from core.planning.fleet import plan_fleet
+from core.planning.model import FleetProblem, FleetResult, FleetVehicle, PlanProblem
+from core.planning.round import plan
 
 #: RC208 as a city: one coordinate unit is 1 km, one time unit a minute (60 km/h, the
 #: literature's travel time = distance), the horizon 00:00–16:00.

@@ -11,9 +11,9 @@ import numpy as np
 
 from benchmarks.common import REFERENCE, busy_core, euc_2d_matrix, print_table
 from core.params import Depot, Stop
-from core.plan import plan
-from core.round import PlanProblem
-from core.tsp import solve_tour
+from core.planning.model import PlanProblem
+from core.planning.round import plan
+from core.routing.tsp import solve_tour
 
 
 def tsp_quality(loaded: bool) -> None:
@@ -104,8 +104,8 @@ def plan_latency() -> None:
             [
                 n,
                 f"{np.percentile(seconds, 50) * 1000:.0f}",
-                f"{result.solver_runtime_s * 1000:.0f}",
-                result.solver_status,
+                f"{result.solved.runtime_s * 1000:.0f}",
+                result.solved.status,
                 f"{result.duration_s / 3600:.1f}",
                 f"{result.energy_kwh['total']:.1f}",
             ]

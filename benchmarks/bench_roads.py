@@ -15,9 +15,9 @@ import numpy as np
 from app.connectors.osrm import OsrmRouter
 from benchmarks.common import REFERENCE, print_table
 from core.params import Depot, RoadMatrix, Stop, Weather
-from core.plan import plan
-from core.roads import LegRoute, RoadTable
-from core.round import PlanProblem
+from core.planning.model import PlanProblem
+from core.planning.round import plan
+from core.routing.roads import LegRoute, RoadTable
 from tools import osrm
 
 DEPOT = Depot(id="depot-fontvieille", lat=43.7290, lon=7.4180)

@@ -9,8 +9,8 @@ import numpy as np
 
 from benchmarks.common import best_time_s, print_table
 from core.params import Depot, Location, Stop, VanParams, Weather
-from core.round import PlanProblem
-from core.studies import Season, scenario_grid, speed_sweep
+from core.planning.model import PlanProblem
+from core.planning.studies import Season, scenario_grid, speed_sweep
 
 
 def main() -> None:

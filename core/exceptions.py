@@ -31,6 +31,24 @@ class CoreError(ValueError):
         self.field = field
         self.details = details if details is not None else [(field or "body", message)]
 
+    def under(self, prefix: str) -> CoreError:
+        """The same error with every field it names under ``prefix``: ``stops[1].lat`` under
+        ``request`` is ``request.stops[1].lat``; an error of the whole body names ``prefix``."""
+
+        def scoped(field: str | None) -> str:
+            if field in (None, "", "body"):
+                return prefix
+            return f"{prefix}{field}" if field.startswith("[") else f"{prefix}.{field}"
+
+        return type(self)(
+            self.message, scoped(self.field), [(scoped(f), rule) for f, rule in self.details]
+        )
+
+    def at(self, field: str) -> CoreError:
+        """The same error naming ``field`` instead of its own (a rule of one field that the
+        caller knows by another name)."""
+        return type(self)(self.message, field, [(field, rule) for _, rule in self.details])
+
     def __reduce__(
         self,
     ) -> tuple[type[CoreError], tuple[str, str | None, list[tuple[str, str]]]]:

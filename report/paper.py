@@ -1,10 +1,10 @@
 """``make report``: reproduce the paper's Figs. 8–11 and its claims as docs/paper-reproduction.md.
 
-Runs the studies of :mod:`core.studies` on the paper's Table 1 van (preset ``paper-generic``)
-and, beside it, the real 3.5 t van (``ev-van-3.5t-reefer``), on an 8-stop Vienna round starting
-at 09:00 (Fig. 8); draws the charts with matplotlib and writes a Markdown page with each claim
-of the paper beside our numbers, and the winter share of auxiliaries and comfort with the cab
-HVAC on and off at stops.
+Runs the studies of :mod:`core.planning.studies` on the paper's Table 1 van (preset
+``paper-generic``) and, beside it, the real 3.5 t van (``ev-van-3.5t-reefer``), on an 8-stop
+Vienna round starting at 09:00 (Fig. 8); draws the charts with matplotlib and writes a Markdown
+page with each claim of the paper beside our numbers, and the winter share of auxiliaries and
+comfort with the cab HVAC on and off at stops.
 """
 
 from __future__ import annotations
@@ -22,11 +22,10 @@ from matplotlib.figure import Figure
 from tqdm import tqdm
 
 from app.examples import PLAN_EXAMPLE
-from app.schemas import PlanRequest
+from app.operations.plan import plan_problem
+from app.schemas.plans import PlanRequest
 from app.settings import get_settings
-from app.work import plan_problem
 from core.clock import departure
-from core.cycles import generate_leg
 from core.params import (
     AGGRESSIVE_DRIVER,
     CALM_DRIVER,
@@ -36,10 +35,11 @@ from core.params import (
     Location,
     Weather,
 )
-from core.plan import plan
-from core.round import PlanProblem, PlanResult
-from core.simulate import CONSUMERS, simulate
-from core.studies import Season, scenario_grid, speed_sweep
+from core.physics.cycles import generate_leg
+from core.physics.simulate import CONSUMERS, simulate
+from core.planning.model import PlanProblem, PlanResult
+from core.planning.round import plan
+from core.planning.studies import Season, scenario_grid, speed_sweep
 
 COLORS = {
     "traction": "#4c72b0",

@@ -1,5 +1,5 @@
 """Clients of the outside services, built from the settings; each implements a protocol of
-:mod:`core.roads` and hands the core plain arrays."""
+:mod:`core.routing.roads` and hands the core plain arrays."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from functools import lru_cache
 from app.connectors.osrm import OsrmRouter
 from app.connectors.weather import OpenMeteo
 from app.settings import Settings
-from core.roads import RoadRouter
-from core.weather import WeatherService
+from core.physics.weather import WeatherService
+from core.routing.roads import RoadRouter
 
 
 def router(settings: Settings) -> RoadRouter | None:

@@ -20,7 +20,7 @@ import numpy as np
 
 from core.exceptions import InvalidStopsError, NoRouteError, ServiceUnavailableError
 from core.params import Depot
-from core.roads import LegRoute, RoadTable, bearing_deg
+from core.routing.roads import LegRoute, RoadTable, bearing_deg
 
 SERVICE = "osrm"
 
@@ -30,7 +30,7 @@ def _field(index: int) -> str:
 
 
 class OsrmRouter:
-    """A :class:`core.roads.RoadRouter` backed by an osrm-routed server.
+    """A :class:`core.routing.roads.RoadRouter` backed by an osrm-routed server.
 
     Parameters
     ----------

@@ -19,7 +19,7 @@ import httpx
 import numpy as np
 
 from core.exceptions import ServiceUnavailableError
-from core.weather import HourlyWeather
+from core.physics.weather import HourlyWeather
 
 SERVICE = "weather"
 HOURLY = (
@@ -36,7 +36,7 @@ _WIND_TO_MPS = {"km/h": 1 / 3.6, "m/s": 1.0, "mph": 0.44704, "kn": 0.514444, "kt
 
 
 class OpenMeteo:
-    """A :class:`core.roads.WeatherService` for an Open-Meteo-compatible API.
+    """A :class:`core.routing.roads.WeatherService` for an Open-Meteo-compatible API.
 
     Parameters
     ----------

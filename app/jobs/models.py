@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import datetime as dt
-from typing import Any
+from typing import Any, Literal, get_args
 
 from sqlalchemy import JSON, DateTime, Integer, String, TypeDecorator
 from sqlalchemy.engine import Dialect
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
 
-STATUSES = ("queued", "running", "succeeded", "failed", "cancelled")
-FINISHED = ("succeeded", "failed", "cancelled")
+JobStatus = Literal["queued", "running", "succeeded", "failed", "cancelled"]
+#: Every status, in the order a job goes through them.
+STATUSES: tuple[JobStatus, ...] = get_args(JobStatus)
+#: A job that may still run; one that has ended.
+ACTIVE: tuple[JobStatus, ...] = ("queued", "running")
+FINISHED: tuple[JobStatus, ...] = ("succeeded", "failed", "cancelled")
 
 
 class UtcDateTime(TypeDecorator[dt.datetime]):
@@ -52,6 +56,7 @@ class Job(Base):
     runner: Mapped[str | None] = mapped_column(String(255), nullable=True)
     created_at: Mapped[dt.datetime] = mapped_column(UtcDateTime, index=True)
     dispatched_at: Mapped[dt.datetime | None] = mapped_column(UtcDateTime, nullable=True)
+    run_after: Mapped[dt.datetime | None] = mapped_column(UtcDateTime, nullable=True)
     started_at: Mapped[dt.datetime | None] = mapped_column(UtcDateTime, nullable=True)
     heartbeat_at: Mapped[dt.datetime | None] = mapped_column(UtcDateTime, nullable=True)
     finished_at: Mapped[dt.datetime | None] = mapped_column(UtcDateTime, nullable=True, index=True)

@@ -20,11 +20,11 @@ from typing import Any
 
 from alembic import command
 from alembic.config import Config
-from sqlalchemy import Engine, create_engine, delete, event, select, text, update
+from sqlalchemy import ColumnElement, Engine, create_engine, delete, event, select, text, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session, sessionmaker
 
-from app.jobs.models import FINISHED, Job
+from app.jobs.models import ACTIVE, FINISHED, Job
 
 MIGRATIONS = Path(__file__).with_name("migrations")
 #: A lock key for migrations on PostgreSQL, so replicas starting together upgrade once.
@@ -192,40 +192,41 @@ class JobStore:
             return {str(status): int(count) for status, count in rows}
 
     def claim_next(self, runner: str) -> JobView | None:
-        """Take the oldest queued job for ``runner`` (queued → running)."""
+        """Take the oldest queued job that is due for ``runner`` (queued → running), in one
+        conditional ``UPDATE`` (on PostgreSQL its candidate row is locked, so runners on several
+        servers never wait for each other)."""
+        moment = now()
+        oldest = (
+            select(Job.id)
+            .where(Job.status == "queued", _due(moment))
+            .order_by(Job.created_at, Job.id)
+            .limit(1)
+        )
+        if self.engine.dialect.name == "postgresql":
+            oldest = oldest.with_for_update(skip_locked=True)
         with self._transaction() as session:
-            candidates = session.scalars(
-                select(Job.id)
-                .where(Job.status == "queued")
-                .order_by(Job.created_at)
-                .limit(5)
-                .with_for_update(skip_locked=True)
-            ).all()
-        for job_id in candidates:
-            job = self.claim(job_id, runner)
-            if job is not None:
-                return job
-        return None
+            taken = session.execute(
+                update(Job)
+                .where(Job.id == oldest.scalar_subquery(), Job.status == "queued")
+                .values(_running(runner, moment))
+                .returning(Job.id)
+            ).first()
+            if taken is None:
+                return None
+            job = session.get(Job, taken[0])
+            return None if job is None else JobView.of(job)
 
     def claim(self, job_id: str, runner: str, stale_after_s: float | None = None) -> JobView | None:
-        """Take one job for ``runner``: a queued one, or (with ``stale_after_s``) a running one
-        whose runner has been silent that long. None when it is not to be run."""
+        """Take one job for ``runner``: a queued one that is due, or (with ``stale_after_s``) a
+        running one whose runner has been silent that long. None when it is not to be run."""
         moment = now()
-        takeable = Job.status == "queued"
+        takeable = (Job.status == "queued") & _due(moment)
         if stale_after_s is not None:
             silent_since = moment - dt.timedelta(seconds=stale_after_s)
             takeable = takeable | ((Job.status == "running") & (Job.heartbeat_at < silent_since))
         with self._transaction() as session:
             taken = session.execute(
-                update(Job)
-                .where(Job.id == job_id, takeable)
-                .values(
-                    status="running",
-                    runner=runner,
-                    started_at=moment,
-                    heartbeat_at=moment,
-                    attempts=Job.attempts + 1,
-                )
+                update(Job).where(Job.id == job_id, takeable).values(_running(runner, moment))
             )
             if taken.rowcount != 1:  # type: ignore[attr-defined]
                 return None
@@ -264,13 +265,25 @@ class JobStore:
             )
             return bool(done.rowcount == 1)  # type: ignore[attr-defined]
 
-    def requeue(self, job_id: str, runner: str | None = None) -> bool:
-        """Put a running job back in the queue (its runner lost it, or a retry)."""
+    def requeue(
+        self, job_id: str, runner: str | None = None, *, after_s: float = 0.0, count: bool = True
+    ) -> bool:
+        """Put a running job back in the queue: its runner lost it (any runner), a retry that
+        may run ``after_s`` from now, or a run cut short by a shutdown that does not ``count``
+        as an attempt."""
         with self._transaction() as session:
             query = update(Job).where(Job.id == job_id, Job.status == "running")
             if runner is not None:
                 query = query.where(Job.runner == runner)
-            done = session.execute(query.values(status="queued", runner=None, dispatched_at=None))
+            values: dict[str, Any] = {
+                "status": "queued",
+                "runner": None,
+                "dispatched_at": None,
+                "run_after": now() + dt.timedelta(seconds=after_s) if after_s > 0 else None,
+            }
+            if not count:
+                values["attempts"] = Job.attempts - 1
+            done = session.execute(query.values(values))
             return bool(done.rowcount == 1)  # type: ignore[attr-defined]
 
     def cancel(self, job_id: str) -> JobView | None:
@@ -278,7 +291,7 @@ class JobStore:
         with self._transaction() as session:
             session.execute(
                 update(Job)
-                .where(Job.id == job_id, Job.status.in_(("queued", "running")))
+                .where(Job.id == job_id, Job.status.in_(ACTIVE))
                 .values(status="cancelled", finished_at=now())
             )
             job = session.get(Job, job_id)
@@ -303,11 +316,14 @@ class JobStore:
             return [JobView.of(job) for job in session.scalars(query)]
 
     def undispatched(self, older_than_s: float) -> list[JobView]:
-        """Queued jobs not handed to the broker (or handed long ago, and not started)."""
-        before = now() - dt.timedelta(seconds=older_than_s)
+        """Queued jobs that are due and were not handed to the broker (or were handed long ago
+        and have not started)."""
+        moment = now()
+        before = moment - dt.timedelta(seconds=older_than_s)
         with self._transaction() as session:
             query = select(Job).where(
                 Job.status == "queued",
+                _due(moment),
                 (Job.dispatched_at.is_(None)) | (Job.dispatched_at < before),
             )
             return [JobView.of(job) for job in session.scalars(query)]
@@ -321,11 +337,7 @@ class JobStore:
         with self._transaction() as session:
             done = session.execute(
                 update(Job)
-                .where(
-                    Job.id == job_id,
-                    Job.status.in_(("queued", "running")),
-                    Job.attempts >= max_attempts,
-                )
+                .where(Job.id == job_id, Job.status.in_(ACTIVE), Job.attempts >= max_attempts)
                 .values(status="failed", error=error, finished_at=now())
             )
             return bool(done.rowcount == 1)  # type: ignore[attr-defined]
@@ -338,6 +350,23 @@ class JobStore:
                 delete(Job).where(Job.status.in_(FINISHED), Job.finished_at < before)
             )
             return int(gone.rowcount)  # type: ignore[attr-defined]
+
+
+def _due(moment: dt.datetime) -> ColumnElement[bool]:
+    """A queued job may run now: it is not waiting out a retry's backoff."""
+    return Job.run_after.is_(None) | (Job.run_after <= moment)
+
+
+def _running(runner: str, moment: dt.datetime) -> dict[str, Any]:
+    """The values of a job that ``runner`` takes at ``moment``."""
+    return {
+        "status": "running",
+        "runner": runner,
+        "started_at": moment,
+        "heartbeat_at": moment,
+        "run_after": None,
+        "attempts": Job.attempts + 1,
+    }
 
 
 def _sqlite_pragmas(connection: Any, _: Any) -> None:

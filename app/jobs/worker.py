@@ -6,8 +6,7 @@ from typing import Any
 
 from celery.signals import worker_shutdown
 
-from app.execution import stop_pools
-from app.jobs.celery_app import celery_for
+from app.jobs.celery_app import celery_for, stop_pool
 from app.jobs.store import store_for
 from app.settings import get_settings
 
@@ -19,4 +18,4 @@ app = celery_for(_settings)
 @worker_shutdown.connect  # type: ignore[untyped-decorator]
 def _stop_the_process_pool(**_: Any) -> None:
     # Celery's warm shutdown lets the running jobs end; the pool's threads must then go too.
-    stop_pools()
+    stop_pool()

@@ -4,15 +4,12 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Depends, Request
+from fastapi import APIRouter, Body, Request
 
-from app import work
+from app.deps import ExecutorDep, SettingsDep
 from app.examples import FLEET_PLAN_EXAMPLE
-from app.execution import Executor
-from app.routers.plans import executor
-from app.routers.results import fleet_response
-from app.schemas import FleetPlanRequest, FleetPlanResponse
-from app.settings import Settings, get_settings
+from app.operations.fleet_plan import fleet_response, run_fleet_plan
+from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
 
 router = APIRouter(tags=["fleet"])
 
@@ -36,8 +33,8 @@ async def create_fleet_plan(
         ),
     ],
     http: Request,
-    settings: Annotated[Settings, Depends(get_settings)],
-    pool: Annotated[Executor, Depends(executor)],
+    settings: SettingsDep,
+    pool: ExecutorDep,
 ) -> FleetPlanResponse:
     """Splits the stops across the vans (OR-Tools routing with time windows, shifts, payload
     and each van's battery as constraints) and simulates every route's day in full: the charge
@@ -45,8 +42,6 @@ async def create_fleet_plan(
     before its shift ends, deliveries fit the payload. A route the simulation rejects is
     tightened and solved again within `time_limit_s`; stops no van can serve are listed in
     `unassigned` with their reason. Solved in a worker process, as plans are."""
-    result = await pool.run(
-        work.run_fleet_plan, request, settings, disconnected=http.is_disconnected
-    )
-    http.app.state.metrics.solve.observe(result.solver_runtime_s)
+    result = await pool.run(run_fleet_plan, request, settings, disconnected=http.is_disconnected)
+    http.app.state.metrics.solve.observe(result.runtime_s)
     return fleet_response(result, request.include_geometry)

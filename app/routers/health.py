@@ -5,17 +5,15 @@ from __future__ import annotations
 import asyncio
 from collections.abc import Callable
 from importlib.metadata import version
-from typing import Annotated
 
 import httpx
-from fastapi import APIRouter, Depends, Request
+from fastapi import APIRouter, Request
 from fastapi.responses import JSONResponse
 
-from app.execution import Executor
+from app.deps import ExecutorDep, SettingsDep
+from app.jobs.celery_app import celery_for
 from app.jobs.store import store_for
-from app.routers.plans import executor
-from app.schemas import Check, Health, Readiness
-from app.settings import Settings, get_settings
+from app.schemas.service import Check, Health, Readiness
 
 router = APIRouter(tags=["health"])
 #: How long one dependency may take to answer the readiness probe [s].
@@ -59,8 +57,8 @@ def _http_probe(url: str) -> Callable[[], str]:
 )
 async def readiness(
     http: Request,
-    settings: Annotated[Settings, Depends(get_settings)],
-    pool: Annotated[Executor, Depends(executor)],
+    settings: SettingsDep,
+    pool: ExecutorDep,
 ) -> JSONResponse:
     """Whether the worker pool is alive and the database, the broker and every configured
     outside service answer; 503 naming what is down."""
@@ -78,8 +76,6 @@ async def readiness(
     if settings.broker_url is not None:
 
         def broker() -> str:
-            from app.jobs.celery_app import celery_for
-
             with celery_for(settings).connection_for_write() as connection:
                 connection.ensure_connection(max_retries=1, timeout=CHECK_TIMEOUT_S)
             return "the broker answers"

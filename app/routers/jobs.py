@@ -5,55 +5,37 @@ from __future__ import annotations
 import asyncio
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Depends, Header, Path, Query, Request, Response
+from fastapi import APIRouter, Body, Header, Path, Query, Request, Response
 from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel, ValidationError
 from starlette.exceptions import HTTPException
 
+from app.deps import SettingsDep, StoreDep
 from app.examples import PLAN_EXAMPLE
-from app.jobs.store import IdempotencyConflictError, JobStore, JobView, store_for
-from app.schemas import (
-    FleetPlanRequest,
-    JobList,
-    JobOut,
-    JobRequest,
-    JobStatus,
-    JobSubmission,
-    JobSummary,
-    PlanRequest,
-    ScenariosRequest,
-)
-from app.settings import Settings, get_settings
-from app.work import check_job
+from app.jobs.models import FINISHED, JobStatus
+from app.jobs.schemas import JobList, JobOut, JobSubmission, JobSummary
+from app.jobs.store import IdempotencyConflictError, JobStore, JobView
+from app.operations.kinds import JOB_KINDS
+from app.settings import Settings
 from core.exceptions import CoreError
 
 router = APIRouter(prefix="/jobs", tags=["jobs"])
-REQUEST_MODELS: dict[str, type[BaseModel]] = {
-    "plan": PlanRequest,
-    "fleet-plan": FleetPlanRequest,
-    "scenarios": ScenariosRequest,
-}
 
 
-def job_store(settings: Annotated[Settings, Depends(get_settings)]) -> JobStore:
-    return store_for(settings.database_url)
-
-
-def _validated(submission: JobSubmission, settings: Settings) -> JobRequest:
-    """The job's request as the synchronous endpoint would validate it, fields named under
-    ``request.``."""
+def _validated(submission: JobSubmission, settings: Settings) -> BaseModel:
+    """The job's request as the synchronous endpoint would validate and check it, every field
+    named under ``request.``."""
+    kind = JOB_KINDS[submission.type]
     try:
-        request = REQUEST_MODELS[submission.type].model_validate(submission.request)
+        request: BaseModel = kind.request.model_validate(submission.request)
     except ValidationError as error:
         raise RequestValidationError(
             [e | {"loc": ("body", "request", *e["loc"])} for e in error.errors()]
         ) from None
-    assert isinstance(request, PlanRequest | FleetPlanRequest | ScenariosRequest)
     try:
-        check_job(submission.type, request, settings)
+        kind.check(request, settings)
     except CoreError as error:
-        field = f"request.{error.field}" if error.field else "request"
-        raise type(error)(error.message, field) from None
+        raise error.under("request") from None
     return request
 
 
@@ -108,8 +90,8 @@ async def create_job(
     ],
     http: Request,
     response: Response,
-    settings: Annotated[Settings, Depends(get_settings)],
-    store: Annotated[JobStore, Depends(job_store)],
+    settings: SettingsDep,
+    store: StoreDep,
     idempotency_key: Annotated[
         str | None,
         Header(
@@ -123,10 +105,7 @@ async def create_job(
     has succeeded, its result — exactly what the synchronous endpoint returns."""
     request = _validated(submission, settings)
     time_limit_s = min(
-        request.plan.time_limit_s
-        if isinstance(request, ScenariosRequest)
-        else request.time_limit_s,
-        settings.max_job_time_limit_s,
+        JOB_KINDS[submission.type].time_limit_s(request), settings.max_job_time_limit_s
     )
     try:
         job, new = await asyncio.to_thread(
@@ -144,9 +123,7 @@ async def create_job(
         ) from None
     runner = getattr(http.app.state, "runner", None)
     if new and runner is not None:
-        if hasattr(runner, "dispatch"):
-            await asyncio.to_thread(runner.dispatch, job)
-        runner.wake()
+        await asyncio.to_thread(runner.submitted, job)
     response.status_code = 202 if new else 200
     response.headers["Location"] = f"/v1/jobs/{job.id}"
     return _out(job)
@@ -154,7 +131,7 @@ async def create_job(
 
 @router.get("", operation_id="listJobs", summary="Jobs, newest first")
 async def list_jobs(
-    store: Annotated[JobStore, Depends(job_store)],
+    store: StoreDep,
     status: Annotated[JobStatus | None, Query(description="Only jobs in this state.")] = None,
     limit: Annotated[int, Query(ge=1, le=500, description="At most this many.")] = 50,
 ) -> JobList:
@@ -172,7 +149,7 @@ JobId = Annotated[str, Path(max_length=64, description="The job's id.")]
     summary="A job's state and result",
     responses={404: {"description": "No such job (or it expired)."}},
 )
-async def get_job(job_id: JobId, store: Annotated[JobStore, Depends(job_store)]) -> JobOut:
+async def get_job(job_id: JobId, store: StoreDep) -> JobOut:
     """Its status and timestamps; its result when it succeeded, its error when it failed."""
     return _out(await asyncio.to_thread(_get, store, job_id))
 
@@ -186,17 +163,14 @@ async def get_job(job_id: JobId, store: Annotated[JobStore, Depends(job_store)])
         409: {"description": "The job has already ended."},
     },
 )
-async def cancel_job(
-    job_id: JobId, http: Request, store: Annotated[JobStore, Depends(job_store)]
-) -> JobOut:
+async def cancel_job(job_id: JobId, store: StoreDep) -> JobOut:
     """A queued job never runs; a running one is stopped (its worker process is terminated).
     A job that has already ended cannot be cancelled (409)."""
     before = await asyncio.to_thread(_get, store, job_id)
-    if before.status in ("succeeded", "failed", "cancelled"):
+    if before.status in FINISHED:
         raise HTTPException(409, f"job {job_id} has already ended ({before.status})")
     job = await asyncio.to_thread(store.cancel, job_id)
-    assert job is not None
-    runner = getattr(http.app.state, "runner", None)
-    if runner is not None:
-        runner.wake()
+    if job is None:  # deleted meanwhile (its retention ran out)
+        raise HTTPException(404, f"no job {job_id}")
+    # The runner watching it stops its worker process within a heartbeat.
     return _out(job)

@@ -4,24 +4,16 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Depends, Header, Request
+from fastapi import APIRouter, Body, Header, Request
 from fastapi.responses import JSONResponse
 
-from app import work
+from app.deps import ExecutorDep, SettingsDep
 from app.examples import PLAN_EXAMPLE
-from app.execution import Executor
-from app.routers.results import plan_geojson, plan_response
-from app.schemas import PlanRequest, PlanResponse
-from app.settings import Settings, get_settings
+from app.operations.plan import plan_geojson, plan_response, run_plan
+from app.schemas.plans import PlanRequest, PlanResponse
 
 router = APIRouter(tags=["plans"])
 GEOJSON = "application/geo+json"
-
-
-def executor(http: Request) -> Executor:
-    """The server's worker pool."""
-    pool: Executor = http.app.state.executor
-    return pool
 
 
 def wants_geojson(accept: str | None) -> bool:
@@ -72,8 +64,8 @@ async def create_plan(
         ),
     ],
     http: Request,
-    settings: Annotated[Settings, Depends(get_settings)],
-    pool: Annotated[Executor, Depends(executor)],
+    settings: SettingsDep,
+    pool: ExecutorDep,
     accept: Annotated[
         str | None,
         Header(description="application/json (default) or application/geo+json for a map."),
@@ -83,8 +75,8 @@ async def create_plan(
     whether the battery holds out. With `COLDROUTE_OSRM_URL` set, distances, durations and each
     leg's speed profile come from the OSRM road router. Solved in a worker process; when every
     worker is busy the request waits in a bounded queue (503 with Retry-After beyond it)."""
-    result = await pool.run(work.run_plan, request, settings, disconnected=http.is_disconnected)
-    http.app.state.metrics.solve.observe(result.solver_runtime_s)
+    result = await pool.run(run_plan, request, settings, disconnected=http.is_disconnected)
+    http.app.state.metrics.solve.observe(result.solved.runtime_s)
     if wants_geojson(accept):
         collection = plan_geojson(result, request.depot.lat, request.depot.lon)
         return JSONResponse(collection.model_dump(mode="json"), media_type=GEOJSON)

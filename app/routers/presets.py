@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter
 
-from app.schemas import PresetsResponse
+from app.schemas.service import PresetsResponse
 from core.params import PRESETS
 
 router = APIRouter(tags=["presets"])

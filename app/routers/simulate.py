@@ -4,14 +4,12 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Depends, Request
+from fastapi import APIRouter, Body, Request
 
-from app import work
+from app.deps import ExecutorDep, SettingsDep
 from app.examples import SIMULATE_EXAMPLE, SIMULATE_TRACE_EXAMPLE
-from app.execution import Executor
-from app.routers.plans import executor
-from app.schemas import SimulateRequest, SimulateResponse
-from app.settings import Settings, get_settings
+from app.operations import simulate as operation
+from app.schemas.simulate import SimulateRequest, SimulateResponse
 
 router = APIRouter(tags=["simulation"])
 
@@ -34,9 +32,11 @@ async def simulate_trace(
         ),
     ],
     http: Request,
-    settings: Annotated[Settings, Depends(get_settings)],
-    pool: Annotated[Executor, Depends(executor)],
+    settings: SettingsDep,
+    pool: ExecutorDep,
 ) -> SimulateResponse:
     """Per-consumer power and energy, state of charge and battery verdict along a trace you send
     (`speed_mps`, `dt_s`, `grade`) or one generated from a street type (`cycle`)."""
-    return await pool.run(work.simulate_trace, request, settings, disconnected=http.is_disconnected)
+    return await pool.run(
+        operation.simulate_trace, request, settings, disconnected=http.is_disconnected
+    )

@@ -4,19 +4,18 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Depends, Request
+from fastapi import APIRouter, Body, Request
 
-from app import work
+from app.deps import ExecutorDep, SettingsDep
 from app.examples import SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
-from app.execution import Executor
-from app.routers.plans import executor
-from app.schemas import (
+from app.operations.studies import run_scenarios as scenarios
+from app.operations.studies import sweep_speeds as sweep
+from app.schemas.studies import (
     ScenariosRequest,
     ScenariosResponse,
     SpeedSweepRequest,
     SpeedSweepResponse,
 )
-from app.settings import Settings, get_settings
 
 router = APIRouter(prefix="/studies", tags=["studies"])
 
@@ -35,12 +34,12 @@ async def sweep_speeds(
         ),
     ],
     http: Request,
-    settings: Annotated[Settings, Depends(get_settings)],
-    pool: Annotated[Executor, Depends(executor)],
+    settings: SettingsDep,
+    pool: ExecutorDep,
 ) -> SpeedSweepResponse:
     """Energy per km of each consumer on flat trips at each speed, and the speed with the
     lowest total: with the cooling unit on, about 40 km/h (paper Fig. 11)."""
-    return await pool.run(work.sweep_speeds, request, settings, disconnected=http.is_disconnected)
+    return await pool.run(sweep, request, settings, disconnected=http.is_disconnected)
 
 
 @router.post("/scenarios", operation_id="runScenarios", summary="Seasons × drivers × traffic")
@@ -57,9 +56,9 @@ async def run_scenarios(
         ),
     ],
     http: Request,
-    settings: Annotated[Settings, Depends(get_settings)],
-    pool: Annotated[Executor, Depends(executor)],
+    settings: SettingsDep,
+    pool: ExecutorDep,
 ) -> ScenariosResponse:
     """The round planned once for its own conditions (the baseline), then simulated on that
     tour for every combination of season, driver aggressiveness and traffic density."""
-    return await pool.run(work.run_scenarios, request, settings, disconnected=http.is_disconnected)
+    return await pool.run(scenarios, request, settings, disconnected=http.is_disconnected)

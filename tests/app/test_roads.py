@@ -13,11 +13,10 @@ from fastapi.testclient import TestClient
 
 from app.connectors.osrm import OsrmRouter
 from app.examples import SCENARIOS_EXAMPLE
-from app.main import create_app
-from app.settings import Settings
 from core.exceptions import NoRouteError
 from core.params import Depot
-from core.round import leg_routes
+from core.planning.day import leg_roads
+from tests.app.apps import app_client
 from tools import osrm
 
 PLACES = {
@@ -50,7 +49,7 @@ def monaco_plan(names, **changes):
 
 
 def client_for(url: str, **settings) -> TestClient:
-    return TestClient(create_app(Settings(osrm_url=url, **settings)))
+    return app_client(osrm_url=url, **settings)
 
 
 @pytest.fixture(scope="module")
@@ -220,7 +219,7 @@ def test_osrm_no_route_between_islands_is_named_by_its_destination(islands_url):
     assert np.isnan(table.distance_m[0, 2]) and np.isnan(table.duration_s[2, 1])
     assert table.distance_m[0, 1] > 0
     with pytest.raises(NoRouteError) as caught:
-        leg_routes(router, island_places(), [0, 1, 2, 0])
+        leg_roads(router, island_places(), [0, 1, 2, 0])
     assert caught.value.field == "stops[1]"
 
 
@@ -285,11 +284,7 @@ def test_the_clients_matrix_wins_over_the_router(roads):
 def test_real_roads_cost_more_than_the_estimate(roads):
     names = list(PLACES)
     real = roads.post("/v1/plans", json=monaco_plan(names, keep_order=True)).json()
-    guess = (
-        TestClient(create_app(Settings()))
-        .post("/v1/plans", json=monaco_plan(names, keep_order=True))
-        .json()
-    )
+    guess = app_client().post("/v1/plans", json=monaco_plan(names, keep_order=True)).json()
     assert guess["distance_source"] == "estimate"
     assert real["totals"]["distance_m"] > 1.3 * guess["totals"]["distance_m"]
     assert real["totals"]["energy_kwh"]["traction"] > guess["totals"]["energy_kwh"]["traction"]

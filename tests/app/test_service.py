@@ -4,15 +4,12 @@ from pathlib import Path
 from fastapi.testclient import TestClient
 
 from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
+from app.jobs.schemas import JobOut
 from app.main import app, create_app
 from app.openapi_doc import RESPONSE_EXAMPLES
-from app.schemas import (
-    JobOut,
-    PlanResponse,
-    ScenariosResponse,
-    SimulateResponse,
-    SpeedSweepResponse,
-)
+from app.schemas.plans import PlanResponse
+from app.schemas.simulate import SimulateResponse
+from app.schemas.studies import ScenariosResponse, SpeedSweepResponse
 from app.settings import Settings
 from core.params import PRESETS
 

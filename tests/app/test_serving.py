@@ -12,7 +12,7 @@ import httpx
 import pytest
 from pebble import ProcessPool
 
-from app.execution import stop_pools, worker_pool
+from app.execution import WorkerPool
 from benchmarks.common import Server
 from tests.app.serving import alive, children, heap_kept_after_churn_bytes, long_plan
 
@@ -146,11 +146,12 @@ def test_workers_keep_freed_memory_for_the_next_simulation():
     # glibc trims the heap's top once 128 kB lie free there; the workers keep it (keep_heap),
     # so numpy's per-second arrays are not faulted in anew at every allocation.
     fresh = ProcessPool(max_workers=1, context=multiprocessing.get_context("spawn"))
+    workers = WorkerPool(1)
     try:
         untuned = fresh.schedule(heap_kept_after_churn_bytes).result(timeout=60)
-        tuned = worker_pool(1).schedule(heap_kept_after_churn_bytes).result(timeout=60)
+        tuned = workers.schedule(heap_kept_after_churn_bytes, ()).result(timeout=60)
     finally:
         fresh.stop()
-        stop_pools()
+        workers.stop()
     assert untuned < 1 << 20
     assert tuned > 6 << 20

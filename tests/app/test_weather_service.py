@@ -10,8 +10,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
-from app.main import create_app
-from app.settings import Settings
+from tests.app.apps import app_client
 from tools.osrm import free_port
 
 # Forecasts are for days to come; the archive answers for days gone.
@@ -23,7 +22,7 @@ ROUND = {k: v for k, v in PLAN_EXAMPLE.items() if k != "weather"} | {
 
 
 def client_for(url: str | None, **settings) -> TestClient:
-    return TestClient(create_app(Settings(weather_url=url, **settings)))
+    return app_client(weather_url=url, **settings)
 
 
 def test_plans_use_the_hourly_forecast(weather_stub):

@@ -2,14 +2,14 @@ import numpy as np
 import pytest
 
 from core.arrays import reflected_cumsum
-from core.battery import (
+from core.params import BatteryParams
+from core.physics.battery import (
     JOULES_PER_KWH,
     battery_energy_j,
     capacity_factor,
     discharge,
     energy_factor,
 )
-from core.params import BatteryParams
 
 KWH = JOULES_PER_KWH
 

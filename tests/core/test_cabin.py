@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from core.cabin import auxiliaries_power_w, cab_deficit_j, cab_power_w, cabin_hvac_power_w
 from core.params import VehicleParams
+from core.physics.cabin import auxiliaries_power_w, cab_deficit_j, cab_power_w, cabin_hvac_power_w
 
 VAN = VehicleParams()
 

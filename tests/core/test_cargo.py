@@ -6,7 +6,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core.cargo import (
+from core.params import CargoBoxParams
+from core.physics.cargo import (
     MAX_CARNOT_COP,
     air_density_kg_m3,
     door_heat_w,
@@ -16,7 +17,6 @@ from core.cargo import (
     refrigeration_cop,
     wall_heat_w,
 )
-from core.params import CargoBoxParams
 
 BOX = CargoBoxParams()
 AREA = 2 * (8 + 4.182 + 3.12)  # 30.604 m²
@@ -135,7 +135,7 @@ def test_empty_box_with_an_open_door_stays_below_the_outside_air():
     # outside air and its sol-air excess. By hand (no sun at 03:00): G = UA + G_door,
     # ϑ_eq = 30 − 3000 W / G, exact response over the 300 s of open door.
     from core.params import DoorOpening, Location, VanParams, Weather
-    from core.simulate import simulate
+    from core.physics.simulate import simulate
 
     box = CargoBoxParams(mode="dynamic")
     van = VanParams(cargo_box=box)

@@ -7,7 +7,7 @@ import pytest
 from core.clock import at, departure, local_clock
 from core.exceptions import InvalidParameterError
 from core.params import Location, VanParams, Weather
-from core.simulate import simulate, sun
+from core.physics.simulate import simulate, sun
 
 VIENNA = ZoneInfo("Europe/Vienna")
 

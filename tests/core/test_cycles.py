@@ -3,7 +3,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core.cycles import (
+from core.exceptions import InvalidParameterError
+from core.params import STREET_TYPES, StreetType
+from core.physics.cycles import (
     drive_profile,
     generate_leg,
     load_cycle_csv,
@@ -11,8 +13,6 @@ from core.cycles import (
     stretch_to_duration,
     trace_distance_m,
 )
-from core.exceptions import InvalidParameterError
-from core.params import STREET_TYPES, StreetType
 
 URBAN = STREET_TYPES["urban"]
 

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from core.exceptions import InvalidMatrixError
-from core.geo import (
+from core.params import STREET_TYPES, Depot, RoadMatrix
+from core.routing.geo import (
     DETOUR_FACTOR,
     EARTH_RADIUS_M,
     build_legs,
@@ -12,7 +13,6 @@ from core.geo import (
     street_type_by_length,
     street_type_by_speed,
 )
-from core.params import STREET_TYPES, Depot, RoadMatrix
 
 
 def test_one_degree_of_latitude():

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from core.exceptions import CoreError, InvalidStopsError
-from core.geo import build_legs
 from core.params import (
     BatteryParams,
     CargoBoxParams,
@@ -17,9 +16,10 @@ from core.params import (
     VehicleParams,
     Weather,
 )
-from core.plan import plan
-from core.round import PlanProblem
-from core.weather import climatology
+from core.physics.weather import climatology
+from core.planning.model import PlanProblem
+from core.planning.round import plan
+from core.routing.geo import build_legs
 
 DEPOT = Depot(id="depot", lat=48.2082, lon=16.3738)
 
@@ -54,7 +54,7 @@ def test_tour_is_a_round_trip_and_distance_optimal():
         sum(d[a, b] for a, b in itertools.pairwise([0, *p, 0]))
         for p in itertools.permutations(range(1, 8))
     )
-    assert result.solver_status == "optimal" and result.objective_value == best
+    assert result.solved.status == "optimal" and result.solved.objective_value == best
     assert result.distance_m == pytest.approx(best, rel=1e-3)
 
 
@@ -62,9 +62,9 @@ def test_same_input_same_plan():
     p = problem(round_of(6))
     first, second = plan(p), plan(p)
     # everything but the solver's wall-clock time
-    assert dataclasses.replace(first, solver_runtime_s=0) == dataclasses.replace(
-        second, solver_runtime_s=0
-    )
+    assert dataclasses.replace(
+        first, solved=dataclasses.replace(first.solved, runtime_s=0)
+    ) == dataclasses.replace(second, solved=dataclasses.replace(second.solved, runtime_s=0))
 
 
 def test_legs_and_stops_add_up_to_the_totals():
@@ -124,13 +124,13 @@ def test_energy_objective_takes_the_cheaper_direction_up_the_hill():
     assert steep_up.energy_kwh["total"] < gentle_up.energy_kwh["total"]
     by_energy = plan(base.model_copy(update={"objective": "energy", "keep_order": False}))
     assert by_energy.tour == ["depot", "A", "M", "B", "depot"]
-    assert by_energy.solver_status == "optimal"
+    assert by_energy.solved.status == "optimal"
     for stops_order in (stops, stops[::-1]):
         by_distance = plan(base.model_copy(update={"stops": stops_order, "keep_order": False}))
         assert by_energy.energy_kwh["total"] <= by_distance.energy_kwh["total"] + 1e-9
     # the estimate behind the objective is close to the full simulation (driving only)
     driving = sum(leg.energy_kwh["total"] for leg in by_energy.legs) * 1000
-    assert by_energy.objective_value == pytest.approx(driving, rel=0.1)
+    assert by_energy.solved.objective_value == pytest.approx(driving, rel=0.1)
 
 
 def test_small_battery_is_infeasible_at_the_right_leg():

@@ -6,10 +6,10 @@ from zoneinfo import ZoneInfo
 import numpy as np
 import pytest
 
-from core.cargo import door_heat_w, refrigeration_cop, wall_heat_w
-from core.cycles import load_cycle_csv
 from core.params import PRESETS, Location, VehicleParams, Weather
-from core.simulate import simulate
+from core.physics.cargo import door_heat_w, refrigeration_cop, wall_heat_w
+from core.physics.cycles import load_cycle_csv
+from core.physics.simulate import simulate
 
 VAN = PRESETS["ev-van-3.5t-reefer"].van()
 APRIL = dt.datetime(2026, 4, 15, 10, tzinfo=ZoneInfo("Europe/Vienna"))

@@ -6,7 +6,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core.cycles import generate_leg, load_cycle_csv
 from core.exceptions import InvalidParameterError
 from core.params import (
     AGGRESSIVE_DRIVER,
@@ -20,7 +19,8 @@ from core.params import (
     VanParams,
     Weather,
 )
-from core.simulate import simulate
+from core.physics.cycles import generate_leg, load_cycle_csv
+from core.physics.simulate import simulate
 
 VIENNA = Location(lat=48.21, lon=16.37)
 TZ = ZoneInfo("Europe/Vienna")

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from core.params import CargoBoxParams
-from core.solar import (
+from core.physics.solar import (
     absorbed_solar_heat_w,
     declination_deg,
     direct_irradiance_w_m2,

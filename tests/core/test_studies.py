@@ -6,9 +6,9 @@ import pytest
 
 from core.exceptions import InvalidParameterError
 from core.params import CargoBoxParams, Depot, Location, Stop, VanParams, VehicleParams, Weather
-from core.plan import plan
-from core.round import PlanProblem
-from core.studies import Season, scenario_grid, speed_sweep
+from core.planning.model import PlanProblem
+from core.planning.round import plan
+from core.planning.studies import Season, scenario_grid, speed_sweep
 
 NOON = dt.datetime(2026, 7, 15, 12, tzinfo=ZoneInfo("Europe/Vienna"))
 VIENNA = Location(lat=48.21, lon=16.37)

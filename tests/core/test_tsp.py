@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from benchmarks.common import euc_2d_matrix
-from core.tsp import solve_tour, tour_cost
+from core.routing.tsp import solve_tour, tour_cost
 
 
 def brute_force(cost: np.ndarray) -> int:

@@ -4,7 +4,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from core.params import GRAVITY_MPS2, VehicleParams
-from core.vehicle import (
+from core.physics.vehicle import (
     drag_force_n,
     electric_power_w,
     motor_limited_power_w,

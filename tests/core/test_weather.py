@@ -7,7 +7,7 @@ import pytest
 from core.clock import local_clock
 from core.exceptions import InvalidParameterError
 from core.params import Weather
-from core.weather import (
+from core.physics.weather import (
     WIND_HEIGHT_FACTOR,
     HourlyWeather,
     climatology,

@@ -3,7 +3,7 @@
 The core never talks to the network. A road router (OSRM, :mod:`app.connectors.osrm`)
 implements :class:`RoadRouter` and hands back plain arrays; the planner calls it at the right
 moment (the matrix before the tour, the roads of the chosen tour's legs). The weather service's
-protocol is :class:`core.weather.WeatherService`.
+protocol is :class:`core.physics.weather.WeatherService`.
 """
 
 from __future__ import annotations

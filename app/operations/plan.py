@@ -1,72 +1,50 @@
-"""Core results → response models: the conversions shared by the routers and the jobs."""
+"""``POST /v1/plans`` and jobs of type ``plan``: a request → the core's round → the answer."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from app.schemas import (
-    BatteryOut,
-    BoxOut,
-    DayWeatherOut,
-    EnergyKwh,
-    EnergyShare,
+from app import connectors
+from app.operations.answers import attribution, battery, box, energy, weather
+from app.operations.limits import check_round, time_limit_s
+from app.schemas.base import EnergyShare, LineString, Point
+from app.schemas.plans import (
     Feature,
-    FleetPlanResponse,
-    FleetRouteOut,
-    FleetSolverOut,
-    FleetTotals,
     LegOut,
-    LineString,
     PlanFeatureCollection,
+    PlanRequest,
     PlanResponse,
-    Point,
     SolverOut,
     StopOut,
     Totals,
-    UnassignedOut,
-    WeatherOut,
 )
-from core.battery import BatteryVerdict
-from core.fleet import FleetResult
-from core.params import Weather
-from core.round import PlanResult
-from core.weather import DayWeather, WeatherSource
-
-#: Credit owed wherever OpenStreetMap data is shown (ODbL 1.0).
-OSM_ATTRIBUTION = "© OpenStreetMap contributors, ODbL 1.0 (routes and distances by OSRM)"
+from app.settings import Settings
+from core.planning.model import PlanFields, PlanProblem, PlanResult, fields_of
+from core.planning.round import check, plan
 
 
-def energy(values: dict[str, float]) -> EnergyKwh:
-    return EnergyKwh(**values)
-
-
-def battery(
-    verdict: BatteryVerdict, first_infeasible_leg: int | None, temperature_loss_kwh: float
-) -> BatteryOut:
-    return BatteryOut(
-        feasible=verdict.feasible,
-        min_soc=verdict.min_soc,
-        final_soc=verdict.final_soc,
-        margin_kwh=verdict.margin_kwh,
-        required_capacity_kwh=verdict.required_capacity_kwh,
-        usable_capacity_kwh=verdict.usable_capacity_kwh,
-        temperature_loss_kwh=temperature_loss_kwh,
-        recharge_kwh=verdict.recharge_kwh,
-        first_infeasible_leg=first_infeasible_leg,
+def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
+    """The core problem of a plan request, within the server's limits."""
+    check_round(request, settings)
+    return PlanProblem(
+        **fields_of(request, PlanFields)
+        | {"time_limit_s": time_limit_s(request.time_limit_s, settings)},
+        van=request.van(),
     )
 
 
-def weather(used: Weather, source: WeatherSource, days: list[DayWeather]) -> WeatherOut:
-    return WeatherOut(
-        t_min_c=used.t_min_c,
-        t_max_c=used.t_max_c,
-        source=source,
-        days=[DayWeatherOut(date=d.date, t_min_c=d.t_min_c, t_max_c=d.t_max_c) for d in days],
+def check_plan(request: PlanRequest, settings: Settings) -> None:
+    """Everything but the solve: what a job refuses at submission."""
+    check(plan_problem(request, settings))
+
+
+def run_plan(request: PlanRequest, settings: Settings) -> PlanResult:
+    """Plan a round with the configured road router and weather service."""
+    return plan(
+        plan_problem(request, settings),
+        connectors.router(settings),
+        connectors.weather_service(settings),
     )
-
-
-def box(max_temperature_c: float | None, minutes_above: float | None) -> BoxOut:
-    return BoxOut(max_temperature_c=max_temperature_c, minutes_above_product_limit=minutes_above)
 
 
 def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanResponse:
@@ -99,58 +77,30 @@ def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanRes
         timezone=result.timezone,
         box=box(result.max_box_temperature_c, result.minutes_above_product_limit),
         solver=SolverOut(
-            status=result.solver_status,
+            status=result.solved.status,
             objective=result.objective,
-            objective_value=result.objective_value,
-            runtime_s=result.solver_runtime_s,
+            objective_value=result.solved.objective_value,
+            runtime_s=result.solved.runtime_s,
         ),
         distance_source=result.distance_source,
         warnings=result.warnings,
-        attribution=OSM_ATTRIBUTION if result.distance_source == "osrm" else None,
+        attribution=attribution(result.distance_source),
     )
 
 
-def fleet_response(result: FleetResult, include_geometry: bool = False) -> FleetPlanResponse:
-    """The answer of ``POST /v1/fleet-plans``."""
-    return FleetPlanResponse(
-        routes=[
-            FleetRouteOut(
-                **dict(plan_response(route.plan, include_geometry)),
-                vehicle_id=route.vehicle_id,
-            )
-            for route in result.routes
-        ],
-        unassigned=[UnassignedOut(**vars(u)) for u in result.unassigned],
-        totals=FleetTotals(
-            distance_m=result.distance_m,
-            duration_s=result.duration_s,
-            energy_kwh=energy(result.energy_kwh),
-            grid_kwh=result.grid_kwh,
-            vehicles_used=result.vehicles_used,
-        ),
-        solver=FleetSolverOut(
-            status=result.solver_status,
-            objective=result.objective,
-            objective_value=result.objective_value,
-            runtime_s=result.solver_runtime_s,
-            verification_rounds=result.verification_rounds,
-        ),
-        timezone=result.timezone,
-        distance_source=result.distance_source,
-        warnings=result.warnings,
-        attribution=OSM_ATTRIBUTION if result.distance_source == "osrm" else None,
-    )
+def answer(request: PlanRequest, result: PlanResult) -> PlanResponse:
+    """What the endpoint answers a plan request with (as JSON)."""
+    return plan_response(result, request.include_geometry)
 
 
 def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> PlanFeatureCollection:
     """The round as a GeoJSON FeatureCollection for a web map."""
-    depot_id = result.tour[0]
     features = [
         Feature(
             geometry=Point(coordinates=(depot_lon, depot_lat)),
             properties={
                 "kind": "depot",
-                "id": depot_id,
+                "id": result.tour[0],
                 "depart": result.legs[0].depart.isoformat(),
                 "return": result.legs[-1].arrive.isoformat(),
                 "snap_distance_m": result.depot_snap_distance_m,
@@ -192,7 +142,4 @@ def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> Plan
         features.append(
             Feature(geometry=LineString(coordinates=leg.geometry), properties=properties)
         )
-    return PlanFeatureCollection(
-        features=features,
-        attribution=OSM_ATTRIBUTION if result.distance_source == "osrm" else None,
-    )
+    return PlanFeatureCollection(features=features, attribution=attribution(result.distance_source))

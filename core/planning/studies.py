@@ -11,7 +11,6 @@ from dataclasses import dataclass
 
 from pydantic import Field
 
-from core.cycles import generate_leg
 from core.exceptions import CoreError, InvalidParameterError
 from core.params import (
     AGGRESSIVE_DRIVER,
@@ -26,11 +25,12 @@ from core.params import (
     VanParams,
     Weather,
 )
-from core.plan import plan
-from core.roads import RememberingRouter, RoadRouter
-from core.round import PlanProblem, PlanResult
-from core.simulate import CONSUMERS, simulate
-from core.weather import WeatherService
+from core.physics.cycles import generate_leg
+from core.physics.simulate import CONSUMERS, simulate
+from core.physics.weather import WeatherService
+from core.planning.model import PlanProblem, PlanResult
+from core.planning.round import plan
+from core.routing.roads import RememberingRouter, RoadRouter
 
 #: Shortest swept trip [m]: shorter ones are all ramp and say nothing about a cruising speed.
 MIN_SWEEP_DISTANCE_M = 100.0
@@ -78,7 +78,7 @@ def speed_sweep(
     distance_m
         Trip length [m], at least 100 m.
     start, location, van, weather
-        As for :func:`core.simulate.simulate`.
+        As for :func:`core.physics.simulate.simulate`.
     """
     if not speeds_kmh:
         raise InvalidParameterError("speeds_kmh must hold at least one speed", "speeds_kmh")
@@ -182,8 +182,9 @@ def scenario_grid(
     progress
         Called with (cells done, cells in all) after each cell.
     router, weather_service
-        As for :func:`core.plan.plan`; the router is asked once per leg for the whole grid.
-        A season with its own weather keeps it; the others get the service's forecast.
+        As for :func:`core.planning.round.plan`; the router is asked once per leg for the
+        whole grid. A season with its own weather keeps it; the others get the service's
+        forecast.
     """
     seasons = list(seasons) if seasons is not None else default_seasons(problem.date.year)
     drivers = list(drivers) if drivers is not None else list(DEFAULT_DRIVERS)

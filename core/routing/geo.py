@@ -1,9 +1,9 @@
 """Legs between every ordered pair of places: distance, duration, street type and grade.
 
-Three sources, in this order: the client's own road matrices (checked here), a road router's
-table (:class:`core.roads.RoadTable`), or the built-in estimate — great-circle distance times a
-detour factor, the street type by leg length and the duration from that street type's mean
-speed. With known durations the street type follows the leg's mean speed.
+Three sources, in this order: the client's own road matrices (checked here), a road
+router's table (:class:`core.routing.roads.RoadTable`), or the built-in estimate — great-circle
+distance times a detour factor, the street type by leg length and the duration from that
+street type's mean speed. With known durations the street type follows the leg's mean speed.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from core.arrays import FloatArray
 from core.exceptions import InvalidMatrixError
 from core.params import STREET_TYPES, Depot, RoadMatrix, StreetTypeName
-from core.roads import RoadTable
+from core.routing.roads import RoadTable
 
 DistanceSource = Literal["osrm", "client", "estimate"]
 

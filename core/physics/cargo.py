@@ -187,7 +187,7 @@ def refrigeration(
     ambient_c
         Ambient temperature of each step [°C].
     solar_heat
-        Absorbed solar heat of each step [W] (:func:`core.solar.absorbed_solar_heat_w`).
+        Absorbed solar heat of each step [W] (:func:`core.physics.solar.absorbed_solar_heat_w`).
     door_open
         Fraction of each step with the door open [–], 0…1.
     payload_kg

@@ -1,7 +1,7 @@
 """One speed trace in, per-consumer power, energy and state of charge out.
 
 Everything is computed over the whole time grid at once with numpy; there is no Python loop
-per time step (the dynamic cargo box steps every 10 s, :mod:`core.cargo`). A trace of ``n``
+per time step (the dynamic cargo box steps every 10 s, :mod:`core.physics.cargo`). A trace of ``n``
 samples has ``n − 1`` steps; per-step arrays hold the mean power over each step.
 """
 
@@ -15,15 +15,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core import battery as battery_model
 from core.arrays import FloatArray, interval_rates, uniform_interp
-from core.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
-from core.cargo import BoxResult, precondition_energy_j, refrigeration
 from core.clock import SECONDS_PER_DAY, check_representable, local_clock
-from core.cycles import trace_distance_m
 from core.exceptions import InvalidParameterError
 from core.params import DoorOpening, Interval, Location, VanParams, Weather
-from core.solar import (
+from core.physics import battery as battery_model
+from core.physics.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
+from core.physics.cargo import BoxResult, precondition_energy_j, refrigeration
+from core.physics.cycles import trace_distance_m
+from core.physics.solar import (
     absorbed_solar_heat_w,
     declination_deg,
     direct_irradiance_w_m2,
@@ -32,10 +32,23 @@ from core.solar import (
     sin_altitude,
     solar_time_h,
 )
-from core.vehicle import step_traction_power_w
-from core.weather import Conditions, DayWeather, Forecast, WeatherSource, conditions, headwind_mps
+from core.physics.vehicle import step_traction_power_w
+from core.physics.weather import (
+    Conditions,
+    DayWeather,
+    Forecast,
+    WeatherSource,
+    conditions,
+    headwind_mps,
+)
 
-CONSUMERS = ("traction", "auxiliaries", "cabin", "refrigeration")
+#: The consumers on the battery, and what each one is.
+CONSUMERS: dict[str, str] = {
+    "traction": "drive train, net of regeneration",
+    "auxiliaries": "lights, radio, controls",
+    "cabin": "cab heating / air conditioning",
+    "refrigeration": "refrigeration unit, box heater and standby",
+}
 #: Highest speed a trace may hold [m/s] (250 km/h): anything faster is a unit mistake.
 MAX_SPEED_MPS = 250 / 3.6
 #: Steepest grade accepted [–] (the steepest public streets are about 0.35).
@@ -58,7 +71,7 @@ class SimulationResult:
     energy_kwh
         Energy of each consumer and ``total`` [kWh].
     battery_loss_kwh
-        Extra battery energy of the temperature derating (:mod:`core.battery`) [kWh].
+        Extra battery energy of the temperature derating (:mod:`core.physics.battery`) [kWh].
     grid_kwh
         Energy drawn from the grid before departure to pre-condition cab and box [kWh].
     distance_m, duration_s

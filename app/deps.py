@@ -1,0 +1,44 @@
+"""The FastAPI dependencies every router shares, declared once as ``Annotated`` aliases."""
+
+from __future__ import annotations
+
+import secrets
+from typing import Annotated
+
+from fastapi import Depends, HTTPException, Request
+
+from app.execution import Executor
+from app.jobs.store import JobStore, store_for
+from app.settings import Settings, get_settings
+
+SettingsDep = Annotated[Settings, Depends(get_settings)]
+
+
+def _executor(http: Request) -> Executor:
+    """The server's worker pool."""
+    pool: Executor = http.app.state.executor
+    return pool
+
+
+ExecutorDep = Annotated[Executor, Depends(_executor)]
+
+
+def _job_store(settings: SettingsDep) -> JobStore:
+    return store_for(settings.database_url)
+
+
+StoreDep = Annotated[JobStore, Depends(_job_store)]
+
+
+def require_api_key(settings: SettingsDep, request: Request) -> None:
+    """401 unless the request carries the configured key (no key configured: open). The key
+    is a security scheme in the OpenAPI document (app.openapi_doc), not a parameter."""
+    if settings.api_key is None:
+        return
+    x_api_key = request.headers.get("x-api-key")
+    expected = settings.api_key.get_secret_value().encode()
+    # Bytes: compare_digest refuses non-ASCII text, and any key a client sends is just wrong.
+    if x_api_key is None or not secrets.compare_digest(x_api_key.encode(), expected):
+        raise HTTPException(
+            401, "missing or wrong X-API-Key", headers={"WWW-Authenticate": "ApiKey"}
+        )

@@ -1,0 +1,168 @@
+"""One job lifecycle, for the server's own runner and for the Celery workers alike: claim a job,
+watch its run (heartbeat, cancellation, time limit) and record how it ended — its answer, a
+failure, or a retry after its backoff (:class:`RetryPolicy`).
+
+The database is the truth, so nothing accepted is lost: a running job says it is alive every
+``job_heartbeat_s``; one silent for ``job_stale_after_s`` has lost its worker (the server or a
+Celery worker was killed) and goes back to the queue (:meth:`Lifecycle.sweep`), up to
+``job_max_attempts`` runs. Finished jobs are deleted after ``job_retention_s``.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import time
+import uuid
+from concurrent.futures import CancelledError, Future
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from pebble import ProcessExpired
+
+from app.errors import core_problem, problem_body, service_problem
+from app.execution import UnavailableError
+from app.jobs.store import JobStore, JobView
+from app.settings import Settings
+from core.exceptions import CoreError, ServiceUnavailableError
+
+_log = logging.getLogger("coldroute.jobs")
+#: Time a job may run beyond its solver budget: routing, weather and the simulation [s].
+JOB_EXTRA_TIME_S = 120.0
+#: How often the housekeeping runs (stale jobs, retention, undispatched jobs) [s].
+SWEEP_EVERY_S = 2.0
+#: How a watched run ended.
+Ending = Literal["succeeded", "failed", "cancelled", "retrying", "interrupted"]
+
+
+def runner_name() -> str:
+    """This process's name in the ``runner`` column."""
+    return f"{socket.gethostname()}:{os.getpid()}:{uuid.uuid4().hex[:8]}"
+
+
+def time_limit_s(job: JobView) -> float:
+    """Longest a job may run [s]."""
+    return job.time_limit_s + JOB_EXTRA_TIME_S
+
+
+@dataclass(frozen=True)
+class RetryPolicy:
+    """When a failed run is tried again: only when another run may succeed (an outside
+    service or a worker was lost; a plan is a pure function of its request), at most
+    ``max_attempts`` runs in all, each retry after its backoff.
+
+    Attributes
+    ----------
+    max_attempts
+        Runs of a job before it is failed.
+    backoff_s
+        Wait before the 2nd, 3rd, … run [s]; the last value repeats.
+    """
+
+    max_attempts: int
+    backoff_s: tuple[float, ...] = (5.0, 20.0, 60.0)
+
+    def retry_after_s(self, attempts: int) -> float | None:
+        """The wait before the next run after ``attempts`` runs [s], or None: no more runs."""
+        if attempts >= self.max_attempts:
+            return None
+        return self.backoff_s[min(attempts, len(self.backoff_s)) - 1]
+
+
+def failure(error: BaseException) -> tuple[dict[str, Any], bool]:
+    """The problem document of a failed run and whether another run may succeed."""
+    if isinstance(error, CoreError):
+        return core_problem(error), False
+    if isinstance(error, ServiceUnavailableError):
+        return service_problem(error), True
+    if isinstance(error, UnavailableError | ProcessExpired):
+        reason = error.reason if isinstance(error, UnavailableError) else "its worker was lost"
+        return problem_body(503, "Service unavailable", reason, service="workers"), True
+    _log.error("job failed unexpectedly", exc_info=error)
+    return problem_body(
+        500, "Internal error", "An unexpected error occurred; it has been logged."
+    ), False
+
+
+class Lifecycle:
+    """The lifecycle of the jobs one runner takes (``runner`` names it in the store)."""
+
+    def __init__(self, store: JobStore, settings: Settings, runner: str) -> None:
+        self.store = store
+        self.settings = settings
+        self.runner = runner
+        self.policy = RetryPolicy(settings.job_max_attempts)
+
+    def claim_next(self) -> JobView | None:
+        """The oldest due job, now running here."""
+        return self.store.claim_next(self.runner)
+
+    def claim(self, job_id: str) -> JobView | None:
+        """This job, now running here: if it is queued and due, or its runner went silent."""
+        return self.store.claim(job_id, self.runner, self.settings.job_stale_after_s)
+
+    def watch(self, job: JobView, future: Future[Any]) -> Ending:
+        """Wait for the run of ``job`` in ``future`` (a worker process), beating its heartbeat,
+        stopping it when it is cancelled or runs out of time, and record how it ended."""
+        limit_s = time_limit_s(job)
+        deadline = time.monotonic() + limit_s
+        while True:
+            try:
+                result = future.result(timeout=self.settings.job_heartbeat_s)
+            except TimeoutError:
+                if future.done():  # the pool's own time limit ended the run
+                    return self._out_of_time(job, limit_s)
+            except CancelledError:  # the server shuts down: another run, not counted
+                self.store.requeue(job.id, self.runner, count=False)
+                return "interrupted"
+            except Exception as error:
+                return self._failed(job, error)
+            else:
+                self.store.finish(job.id, self.runner, result=result)
+                return "succeeded"
+            if time.monotonic() > deadline:
+                future.cancel()
+                return self._out_of_time(job, limit_s)
+            self.store.heartbeat([job.id], self.runner)
+            if self.store.cancelled_among([job.id]):
+                future.cancel()  # Pebble stops the worker process
+                return "cancelled"
+
+    def _out_of_time(self, job: JobView, limit_s: float) -> Ending:
+        problem = problem_body(504, "Time limit exceeded", f"the job ran longer than {limit_s:g} s")
+        self.store.finish(job.id, self.runner, error=problem)
+        return "failed"
+
+    def _failed(self, job: JobView, error: Exception) -> Ending:
+        problem, retryable = failure(error)
+        wait_s = self.policy.retry_after_s(job.attempts) if retryable else None
+        if wait_s is not None:
+            self.store.requeue(job.id, self.runner, after_s=wait_s)
+            _log.warning("job %s failed (%s); again in %g s", job.id, problem["detail"], wait_s)
+            return "retrying"
+        self.store.finish(job.id, self.runner, error=problem)
+        return "failed"
+
+    def sweep(self) -> list[JobView]:
+        """Requeue the jobs whose runner went silent (fail those out of attempts) and purge the
+        expired; the requeued jobs."""
+        settings = self.settings
+        requeued = []
+        for job in self.store.stale(settings.job_stale_after_s):
+            if job.attempts >= settings.job_max_attempts:
+                self.store.fail_exhausted(job.id, settings.job_max_attempts, _exhausted(job))
+            elif self.store.requeue(job.id, job.runner):
+                _log.warning("job %s lost its runner %s; queued again", job.id, job.runner)
+                requeued.append(job)
+        self.store.purge(settings.job_retention_s)
+        return requeued
+
+
+def _exhausted(job: JobView) -> dict[str, Any]:
+    return problem_body(
+        503,
+        "Service unavailable",
+        f"the job lost its worker {job.attempts} times; it was given up",
+        service="workers",
+    )

@@ -1,0 +1,75 @@
+"""The server's own job runner: jobs on the server's worker pool, a few at a time, with the one
+lifecycle (:mod:`app.jobs.lifecycle`)."""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+
+from app.execution import Executor
+from app.jobs.lifecycle import SWEEP_EVERY_S, Lifecycle, runner_name
+from app.jobs.store import JobStore, JobView
+from app.operations.kinds import run_job
+from app.settings import Settings
+
+_log = logging.getLogger("coldroute.jobs")
+#: How often the runner looks for queued jobs when nobody tells it of one [s].
+LOOK_EVERY_S = 0.5
+
+
+class LocalRunner:
+    """Runs queued jobs on the server's worker pool, ``job_concurrency`` at a time."""
+
+    def __init__(self, store: JobStore, executor: Executor, settings: Settings) -> None:
+        self.executor = executor
+        self.settings = settings
+        self.lifecycle = Lifecycle(store, settings, runner_name())
+        self.watching: set[asyncio.Task[object]] = set()
+        self._loop_task: asyncio.Task[None] | None = None
+        self._queued = asyncio.Event()
+
+    def start(self) -> None:
+        self._loop_task = asyncio.create_task(self._loop())
+
+    def submitted(self, job: JobView) -> None:
+        """A job was queued: look now."""
+        self._queued.set()
+
+    async def stop(self) -> None:
+        """Take no more jobs; the runs under way end with the worker pool (a shutdown puts them
+        back in the queue without counting the run)."""
+        if self._loop_task is not None:
+            self._loop_task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._loop_task
+
+    async def _loop(self) -> None:
+        last_sweep = 0.0
+        loop = asyncio.get_running_loop()
+        while True:
+            try:
+                if loop.time() - last_sweep >= SWEEP_EVERY_S:
+                    await asyncio.to_thread(self.lifecycle.sweep)
+                    last_sweep = loop.time()
+                while len(self.watching) < self.settings.job_concurrency:
+                    if not await self._take():
+                        break
+            except Exception:  # the database may be briefly away: keep going
+                _log.exception("job runner: housekeeping failed; retrying")
+            self._queued.clear()
+            with contextlib.suppress(TimeoutError):
+                await asyncio.wait_for(self._queued.wait(), LOOK_EVERY_S)
+
+    async def _take(self) -> bool:
+        """Claim the next job and start it; whether there was one."""
+        if self.executor.draining:  # a job claimed now could not finish
+            return False
+        job = await asyncio.to_thread(self.lifecycle.claim_next)
+        if job is None:
+            return False
+        future = await self.executor.start(run_job, job.type, job.request, self.settings)
+        watch = asyncio.create_task(asyncio.to_thread(self.lifecycle.watch, job, future))
+        self.watching.add(watch)
+        watch.add_done_callback(self.watching.discard)
+        return True

@@ -1,0 +1,49 @@
+"""Core results → the parts of an answer that several operations share."""
+
+from __future__ import annotations
+
+from app.schemas.base import BatteryOut, BoxOut, DayWeatherOut, EnergyKwh, WeatherOut
+from core.params import Weather
+from core.physics.battery import BatteryVerdict
+from core.physics.weather import DayWeather, WeatherSource
+
+#: Credit owed wherever OpenStreetMap data is shown (ODbL 1.0).
+OSM_ATTRIBUTION = "© OpenStreetMap contributors, ODbL 1.0 (routes and distances by OSRM)"
+
+
+def energy(values: dict[str, float]) -> EnergyKwh:
+    return EnergyKwh(**values)
+
+
+def battery(
+    verdict: BatteryVerdict, first_infeasible_leg: int | None, temperature_loss_kwh: float
+) -> BatteryOut:
+    return BatteryOut(
+        feasible=verdict.feasible,
+        min_soc=verdict.min_soc,
+        final_soc=verdict.final_soc,
+        margin_kwh=verdict.margin_kwh,
+        required_capacity_kwh=verdict.required_capacity_kwh,
+        usable_capacity_kwh=verdict.usable_capacity_kwh,
+        temperature_loss_kwh=temperature_loss_kwh,
+        recharge_kwh=verdict.recharge_kwh,
+        first_infeasible_leg=first_infeasible_leg,
+    )
+
+
+def weather(used: Weather, source: WeatherSource, days: list[DayWeather]) -> WeatherOut:
+    return WeatherOut(
+        t_min_c=used.t_min_c,
+        t_max_c=used.t_max_c,
+        source=source,
+        days=[DayWeatherOut(date=d.date, t_min_c=d.t_min_c, t_max_c=d.t_max_c) for d in days],
+    )
+
+
+def box(max_temperature_c: float | None, minutes_above: float | None) -> BoxOut:
+    return BoxOut(max_temperature_c=max_temperature_c, minutes_above_product_limit=minutes_above)
+
+
+def attribution(distance_source: str) -> str | None:
+    """The credit for the map data an answer's legs were routed on, if any."""
+    return OSM_ATTRIBUTION if distance_source == "osrm" else None

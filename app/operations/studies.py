@@ -1,0 +1,108 @@
+"""``POST /v1/studies/*`` and jobs of type ``scenarios``: the speed sweep and the scenario grid."""
+
+from __future__ import annotations
+
+from app import connectors
+from app.operations.answers import energy
+from app.operations.plan import check_plan, plan_problem
+from app.schemas.base import ConsumptionWhPerKm
+from app.schemas.studies import (
+    ScenarioCellOut,
+    ScenariosRequest,
+    ScenariosResponse,
+    SpeedPointOut,
+    SpeedSweepRequest,
+    SpeedSweepResponse,
+)
+from app.settings import Settings
+from core.clock import departure
+from core.exceptions import CoreError, LimitExceededError
+from core.planning.studies import default_seasons, scenario_grid, speed_sweep
+
+
+def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepResponse:
+    """Energy per km at each constant speed (``POST /v1/studies/speed-sweep``)."""
+    start, _ = departure(request.date, request.start_time, request.timezone, request.location.lon)
+    for index, speed_kmh in enumerate(request.speeds_kmh):
+        # Each trip is a trace of its own: at least its distance at its speed, every second.
+        if speed_kmh > 0 and request.distance_m / (speed_kmh / 3.6) > settings.max_trace_samples:
+            raise LimitExceededError(
+                f"{request.distance_m:g} m at {speed_kmh:g} km/h takes more than "
+                f"{settings.max_trace_samples} s; this server simulates at most that many samples",
+                f"speeds_kmh[{index}]",
+            )
+    try:
+        sweep = speed_sweep(
+            request.speeds_kmh,
+            request.distance_m,
+            start,
+            request.location,
+            request.van(),
+            request.weather,
+            request.driver_aggressiveness,
+            request.traffic_density,
+        )
+    except CoreError as error:
+        if error.field == "start":  # the trips would run past the year 9999
+            raise error.at("date") from None
+        raise
+    return SpeedSweepResponse(
+        points=[
+            SpeedPointOut(
+                speed_kmh=p.speed_kmh, energy_wh_per_km=ConsumptionWhPerKm(**p.energy_wh_per_km)
+            )
+            for p in sweep.points
+        ],
+        optimum_speed_kmh=sweep.optimum_speed_kmh,
+    )
+
+
+def check_scenarios(request: ScenariosRequest, settings: Settings) -> None:
+    """A scenario grid within the server's limit of cells × stops."""
+    seasons = request.seasons or default_seasons(request.plan.date.year)
+    n_cells = (
+        len(seasons)
+        * len(request.driver_aggressiveness or [0] * 3)
+        * len(request.traffic_density or [0] * 2)
+    )
+    if n_cells * len(request.plan.stops) > settings.max_study_cell_stops:
+        raise LimitExceededError(
+            f"{n_cells} cells of {len(request.plan.stops)} stops; this server evaluates at most "
+            f"{settings.max_study_cell_stops} cell-stops per study",
+            "plan.stops",
+        )
+
+
+def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosResponse:
+    """One round over seasons × drivers × traffic (``POST /v1/studies/scenarios``)."""
+    check_scenarios(request, settings)
+    seasons = request.seasons or default_seasons(request.plan.date.year)
+    try:
+        grid = scenario_grid(
+            plan_problem(request.plan, settings),
+            seasons,
+            request.driver_aggressiveness,
+            request.traffic_density,
+            router=connectors.router(settings),
+            weather_service=connectors.weather_service(settings),
+        )
+    except CoreError as error:  # the round's own fields sit under plan.
+        if error.field is not None and error.field.startswith(("seasons", "plan")):
+            raise
+        raise error.under("plan") from None
+    return ScenariosResponse(
+        tour=grid.tour,
+        baseline_energy_kwh=energy(grid.baseline_energy_kwh),
+        cells=[
+            ScenarioCellOut(**(vars(c) | {"energy_kwh": energy(c.energy_kwh)})) for c in grid.cells
+        ],
+    )
+
+
+def check_scenarios_job(request: ScenariosRequest, settings: Settings) -> None:
+    """Everything but the grid itself: what a job refuses at submission."""
+    check_scenarios(request, settings)
+    try:
+        check_plan(request.plan, settings)
+    except CoreError as error:
+        raise error.under("plan") from None

@@ -1,0 +1,168 @@
+"""POST /v1/plans: a round to plan, and the planned and simulated round."""
+
+from __future__ import annotations
+
+import datetime as dt
+from typing import Any, Literal
+
+from pydantic import Field
+
+from app.schemas.base import (
+    ApiModel,
+    AttributionOut,
+    BatteryOut,
+    BoxOut,
+    DistanceSourceOut,
+    EnergyKwh,
+    EnergyShare,
+    LineString,
+    Point,
+    VanRequest,
+    WeatherOut,
+)
+from core.params import Objective, StreetTypeName
+from core.planning.model import PlanFields
+from core.routing.tsp import SolverStatus
+
+
+class GeometryOption(ApiModel):
+    """Whether the answer carries each leg's road."""
+
+    include_geometry: bool = Field(
+        False,
+        description="Return each leg's road as a GeoJSON LineString in legs[].geometry (the "
+        "router's road with OSRM, else the straight line).",
+    )
+
+
+class PlanRequest(VanRequest, GeometryOption, PlanFields):
+    """A delivery round to plan: depot, stops, date, van and conditions. Stops with
+    time_windows are served inside them (the van waits when early); when no order can, the
+    answer is a 422 naming the stop that cannot be reached in time."""
+
+
+class LegOut(ApiModel):
+    """One driven leg."""
+
+    from_id: str = Field(..., description="Where the leg starts: the depot's or a stop's id.")
+    to_id: str = Field(..., description="Where the leg ends: a stop's or the depot's id.")
+    depart: dt.datetime = Field(..., description="Departure, local time with offset.")
+    arrive: dt.datetime = Field(..., description="Arrival, local time with offset.")
+    distance_m: float = Field(..., description="Distance [m].")
+    duration_s: float = Field(..., description="Driving time [s].")
+    street_type: StreetTypeName = Field(
+        ...,
+        description="urban, highway or expressway: by the leg's speeds (router or client) "
+        "or its length (estimate).",
+    )
+    grade: float = Field(..., description="Mean grade, rise over run [–].")
+    energy_kwh: EnergyKwh = Field(
+        ..., description="Energy of each consumer while driving this leg [kWh]."
+    )
+    soc_start: float = Field(..., description="State of charge at departure [–].")
+    soc_end: float = Field(..., description="State of charge on arrival [–].")
+    geometry: LineString | None = Field(
+        None, description="The leg's road; present when the request sets include_geometry."
+    )
+
+
+class StopOut(ApiModel):
+    """One stop, in visiting order."""
+
+    id: str = Field(..., description="The stop's id.")
+    arrival: dt.datetime = Field(..., description="Arrival, local time with UTC offset.")
+    service_start: dt.datetime = Field(
+        ..., description="Service begins (inside a time window), local time with UTC offset."
+    )
+    wait_s: float = Field(
+        ..., description="Waiting for the stop's time window to open, parked [s]."
+    )
+    departure: dt.datetime = Field(
+        ..., description="Departure after the service, local time with UTC offset."
+    )
+    door_heat_kwh: float = Field(..., description="Heat let in through the open door [kWh].")
+    payload_after_kg: float = Field(..., description="Payload when leaving the stop [kg].")
+    energy_kwh: EnergyKwh = Field(..., description="Energy used while standing here [kWh].")
+    soc_arrival: float = Field(..., description="State of charge on arrival [–].")
+    soc_departure: float = Field(..., description="State of charge when leaving [–].")
+    snap_distance_m: float | None = Field(
+        None,
+        description="Distance from the stop to the road the router snapped it to [m]; null "
+        "without a router.",
+    )
+
+
+class Totals(ApiModel):
+    """The whole round."""
+
+    distance_m: float = Field(..., description="Distance of the round [m].")
+    duration_s: float = Field(..., description="From departure to return, stops included [s].")
+    energy_kwh: EnergyKwh = Field(..., description="Energy of each consumer over the round [kWh].")
+    energy_share: EnergyShare = Field(
+        ..., description="Each consumer's share of the round's energy [–]."
+    )
+    grid_kwh: float = Field(
+        0.0,
+        description="Energy from the grid before departure to pre-condition cab and box [kWh] "
+        "(not from the battery).",
+    )
+
+
+class SolverOut(ApiModel):
+    """How the tour search ended."""
+
+    status: SolverStatus = Field(
+        ...,
+        description="optimal (proven over all arcs), feasible (the best found in the time "
+        "limit) or fixed_order (keep_order).",
+    )
+    objective: Objective = Field(
+        ..., description="What the tour minimised: distance, duration or energy."
+    )
+    objective_value: float = Field(..., description="Of the tour, in m, s or Wh (estimate).")
+    runtime_s: float = Field(..., description="Time the tour search took [s].")
+
+
+class PlanResponse(ApiModel):
+    """The planned and simulated round."""
+
+    tour: list[str] = Field(..., description="Ids in driving order, depot first and last.")
+    legs: list[LegOut] = Field(..., description="The driven legs, in order.")
+    stops: list[StopOut] = Field(..., description="The stops, in visiting order.")
+    totals: Totals = Field(..., description="The whole round.")
+    battery: BatteryOut = Field(..., description="Whether the battery holds out with its reserve.")
+    weather: WeatherOut = Field(..., description="The weather the round was simulated with.")
+    timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
+    box: BoxOut = Field(..., description="Cargo-box temperatures (dynamic mode).")
+    solver: SolverOut = Field(..., description="How the tour search ended.")
+    distance_source: DistanceSourceOut
+    warnings: list[str] = Field(
+        default_factory=list,
+        description="What the plan had to do without (e.g. the weather service was down and "
+        "the climatology was used).",
+    )
+    attribution: AttributionOut = None
+
+
+class Feature(ApiModel):
+    """A GeoJSON Feature (RFC 7946)."""
+
+    type: Literal["Feature"] = Field("Feature", description="Always Feature.")
+    geometry: Point | LineString = Field(
+        ..., description="A stop's Point or a leg's LineString, [lon, lat]."
+    )
+    properties: dict[str, Any] = Field(..., description="What the feature is, with its figures.")
+
+
+class PlanFeatureCollection(ApiModel):
+    """The plan as a GeoJSON FeatureCollection: the depot and stops as Points (id, arrival,
+    door heat, state of charge), the legs as LineStrings (energy per consumer, state of charge
+    at both ends)."""
+
+    type: Literal["FeatureCollection"] = Field(
+        "FeatureCollection", description="Always FeatureCollection."
+    )
+    features: list[Feature] = Field(
+        ..., description="The depot and the stops (Points), then the legs (LineStrings)."
+    )
+    attribution: str | None = Field(None, description="Credit for the map data.")

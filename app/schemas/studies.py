@@ -1,0 +1,110 @@
+"""POST /v1/studies/*: the speed sweep and the scenario grid."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from pydantic import Field
+
+from app.schemas.base import ApiModel, ConsumptionWhPerKm, EnergyKwh, VanRequest
+from app.schemas.plans import PlanRequest
+from core.params import ClockTime, IsoDate, Location, Weather, clock_field
+from core.planning.studies import Season
+
+
+class SpeedSweepRequest(VanRequest):
+    """Constant-speed trips on a flat road at several speeds (paper Fig. 11)."""
+
+    speeds_kmh: list[float] = Field(
+        default_factory=lambda: [float(v) for v in range(20, 121, 10)],
+        min_length=1,
+        max_length=100,
+        description="Mean speeds to try [km/h], each in (0, 200].",
+    )
+    distance_m: float = Field(
+        20_000.0, ge=100, le=500_000, description="Trip length [m], at least 100 m."
+    )
+    date: IsoDate = Field(..., description="Day of the trips, YYYY-MM-DD.")
+    start_time: ClockTime = clock_field("12:00", "Departure, local HH:MM.")
+    timezone: str | None = Field(
+        None, max_length=64, description="IANA time zone; absent: local mean solar time."
+    )
+    location: Location = Field(..., description="Where (sun, climatology).")
+    weather: Weather | None = Field(
+        None, description="The day's forecast; absent: the climatology for date and latitude."
+    )
+    traffic_density: float | None = Field(None, gt=0, lt=1, description="ε_t [–].")
+    driver_aggressiveness: float = Field(
+        0.0, ge=0, le=1, description="ε_d [–]; 0 holds each speed exactly (paper Fig. 11)."
+    )
+
+
+class SpeedPointOut(ApiModel):
+    """One speed of the sweep."""
+
+    speed_kmh: float = Field(..., description="The trip's mean speed [km/h].")
+    energy_wh_per_km: ConsumptionWhPerKm = Field(
+        ..., description="Energy per km of each consumer at that speed [Wh/km]."
+    )
+
+
+class SpeedSweepResponse(ApiModel):
+    """Energy per km at each speed, and the speed with the lowest total."""
+
+    points: list[SpeedPointOut] = Field(
+        ..., description="One point per requested speed, in request order."
+    )
+    optimum_speed_kmh: float = Field(
+        ..., description="The speed with the lowest total energy per km [km/h]."
+    )
+
+
+class ScenariosRequest(ApiModel):
+    """One round over seasons × driver aggressiveness × traffic density (paper Figs. 9, 10)."""
+
+    plan: PlanRequest = Field(..., description="The round and its baseline conditions.")
+    seasons: list[Season] | None = Field(
+        None,
+        min_length=1,
+        max_length=12,
+        description="Absent: winter (15 Jan) and summer (15 Jul) of the plan's year.",
+    )
+    driver_aggressiveness: list[Annotated[float, Field(ge=0, le=1)]] | None = Field(
+        None,
+        min_length=1,
+        max_length=10,
+        description="ε_d values [–]; absent: calm 0.2, normal 0.5, aggressive 1.0.",
+    )
+    traffic_density: list[Annotated[float, Field(gt=0, lt=1)]] | None = Field(
+        None,
+        min_length=1,
+        max_length=10,
+        description="ε_t values [–]; absent: light 0.2, heavy 0.8.",
+    )
+
+
+class ScenarioCellOut(ApiModel):
+    """One cell of the grid."""
+
+    season: str = Field(..., description="The season's name.")
+    driver_aggressiveness: float = Field(..., description="ε_d of the cell [–].")
+    traffic_density: float | None = Field(
+        ..., description="ε_t of the cell [–]; null: each street type's default."
+    )
+    energy_kwh: EnergyKwh = Field(..., description="Energy of each consumer in this cell [kWh].")
+    change_vs_baseline_pct: float = Field(..., description="Total energy against the baseline.")
+    feasible: bool = Field(..., description="The battery holds out with its reserve.")
+
+
+class ScenariosResponse(ApiModel):
+    """The grid, one row per cell, on the baseline's tour."""
+
+    tour: list[str] = Field(
+        ..., description="The baseline's tour, driven in every cell: ids, depot first and last."
+    )
+    baseline_energy_kwh: EnergyKwh = Field(
+        ..., description="Energy of the round in its own conditions [kWh]."
+    )
+    cells: list[ScenarioCellOut] = Field(
+        ..., description="One row per season × driver × traffic combination."
+    )

@@ -1,0 +1,121 @@
+"""The base of every parameter model, and the text types requests use for dates and times.
+
+Constructing a model directly from Python with a bad value raises
+:class:`core.exceptions.InvalidParameterError` naming the field and the rule. (When the web
+layer validates a request, pydantic's own error with the full field path is used instead.)
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Annotated, Any
+
+from pydantic import (
+    AwareDatetime,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    PlainSerializer,
+    ValidationError,
+    WithJsonSchema,
+)
+
+from core.exceptions import InvalidParameterError
+
+
+def _iso_text(value: Any) -> Any:
+    """Dates and times come as ISO 8601 text (or as Python's own objects), never as numbers."""
+    if isinstance(value, str | dt.date | dt.time):
+        return value
+    raise ValueError("expected ISO 8601 text")
+
+
+#: A calendar date from ISO text ("2026-07-15"); see :data:`IsoDateTime`.
+IsoDate = Annotated[dt.date, BeforeValidator(_iso_text), Field(strict=False)]
+#: An instant with its UTC offset from ISO text ("2026-07-15T09:00:00+02:00").
+IsoDateTime = Annotated[AwareDatetime, BeforeValidator(_iso_text), Field(strict=False)]
+
+#: A local clock time as the API writes it: HH:MM, 00:00–23:59.
+HHMM_PATTERN = r"^([01]\d|2[0-3]):[0-5]\d$"
+
+
+def clock_time(value: Any) -> dt.time:
+    """``"09:30"`` → ``time(9, 30)``; a :class:`datetime.time` passes as it is."""
+    if isinstance(value, dt.time):
+        return value
+    if isinstance(value, str) and re.fullmatch(HHMM_PATTERN, value):
+        hour, minute = (int(part) for part in value.split(":"))
+        return dt.time(hour, minute)
+    raise ValueError("expected a local clock time HH:MM (00:00–23:59)")
+
+
+#: A local clock time from "HH:MM" text.
+ClockTime = Annotated[
+    dt.time,
+    BeforeValidator(clock_time),
+    Field(strict=False),
+    WithJsonSchema({"type": "string", "pattern": HHMM_PATTERN}),
+    PlainSerializer(lambda value: value.strftime("%H:%M"), return_type=str),
+]
+
+
+def clock_field(default: str, description: str) -> Any:
+    """A :data:`ClockTime` field with its default as the API writes it ("08:00"), so that the
+    JSON schema shows it so too."""
+    return Field(default, validate_default=True, description=description)
+
+
+#: Standard gravity [m/s²] (CGPM 1901).
+GRAVITY_MPS2 = 9.80665
+#: Duration of the New European Driving Cycle [s] (UNECE R83/R101), the paper's t_NEDC.
+NEDC_DURATION_S = 1180.0
+
+
+def describe_validation_error(error: ValidationError, prefix: str = "") -> str:
+    """One line per pydantic error: ``field.path: rule``."""
+    parts = []
+    for item in error.errors():
+        path = ".".join(str(p) for p in (prefix, *item["loc"]) if p != "")
+        parts.append(f"{path or 'input'}: {item['msg']}")
+    return "; ".join(parts)
+
+
+_INSIDE_VALIDATION: ContextVar[bool] = ContextVar("coldroute_inside_validation", default=False)
+
+
+@contextmanager
+def inside_validation() -> Iterator[None]:
+    """Mark a larger model's validation: nested parameter models then keep pydantic's own
+    error, with its full field path, for the outer model to report."""
+    token = _INSIDE_VALIDATION.set(True)
+    try:
+        yield
+    finally:
+        _INSIDE_VALIDATION.reset(token)
+
+
+class Params(BaseModel):
+    """Base of every parameter model: frozen, no unknown fields, no NaN or infinity."""
+
+    # Strict: no number from a string or a boolean (JSON clients get what the schema says);
+    # dates and times still come from their ISO text (strict=False on those fields).
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False, strict=True)
+
+    def __init__(self, **data: Any) -> None:
+        if _INSIDE_VALIDATION.get():
+            super().__init__(**data)
+            return
+        try:
+            with inside_validation():
+                super().__init__(**data)
+        except ValidationError as error:
+            first = error.errors()[0]["loc"]
+            raise InvalidParameterError(
+                describe_validation_error(error, type(self).__name__),
+                field=".".join(str(p) for p in first) or None,
+            ) from None

@@ -1,0 +1,110 @@
+"""The places of a round: the depot, the stops with their time windows, and a client's road
+matrices."""
+
+from __future__ import annotations
+
+import datetime as dt
+from typing import Annotated, Literal
+
+from pydantic import Field, ValidationError, ValidationInfo, field_validator
+from pydantic_core import InitErrorDetails, PydanticCustomError
+
+from core.params.base import ClockTime, Params
+from core.params.conditions import StreetTypeName
+
+
+class Depot(Params):
+    """Where the round starts and ends."""
+
+    id: str = Field("depot", min_length=1, max_length=64, description="Identifier of the depot.")
+    lat: float = Field(..., ge=-90, le=90, description="Latitude [°], north positive.")
+    lon: float = Field(..., ge=-180, le=180, description="Longitude [°], east positive.")
+    elevation_m: float | None = Field(
+        None, ge=-500, le=9000, description="Elevation above sea level [m]; gives leg grades."
+    )
+
+
+class TimeWindow(Params):
+    """When a stop takes deliveries, local time on the round's date: service starts inside."""
+
+    start: ClockTime = Field(..., description="Opens, local HH:MM.")
+    end: ClockTime = Field(..., description="Closes, local HH:MM; after start.")
+
+    @field_validator("end")
+    @classmethod
+    def _after_start(cls, value: dt.time, info: ValidationInfo) -> dt.time:
+        if "start" in info.data and value <= info.data["start"]:
+            raise ValueError("end must be after start")
+        return value
+
+
+#: Most time windows of one stop.
+MAX_TIME_WINDOWS = 8
+
+
+class Stop(Depot):
+    """A delivery stop."""
+
+    id: str = Field(..., min_length=1, max_length=64, description="Unique identifier of the stop.")
+    service_time_s: float = Field(300.0, ge=0, le=86_400, description="Time spent at the stop [s].")
+    door_open_s: float = Field(
+        60.0, ge=0, le=86_400, description="Time the cargo door is open, within the service [s]."
+    )
+    delivery_kg: float = Field(0.0, ge=0, le=40_000, description="Payload unloaded here [kg].")
+    time_windows: list[TimeWindow] = Field(
+        default_factory=list,
+        max_length=MAX_TIME_WINDOWS,
+        description="When the stop takes deliveries (local time on the round's date), sorted "
+        "and not overlapping: the van may arrive early and wait; service starts inside a "
+        "window. Empty: any time.",
+    )
+
+    @field_validator("time_windows")
+    @classmethod
+    def _windows_in_order(cls, value: list[TimeWindow]) -> list[TimeWindow]:
+        for k in range(1, len(value)):
+            if value[k].start < value[k - 1].end:
+                rule = PydanticCustomError(
+                    "windows_in_order",
+                    "starts at {start}, before window {previous} ends ({end}); windows must be "
+                    "sorted and must not overlap",
+                    {
+                        "start": f"{value[k].start:%H:%M}",
+                        "previous": k - 1,
+                        "end": f"{value[k - 1].end:%H:%M}",
+                    },
+                )
+                raise ValidationError.from_exception_data(
+                    "TimeWindow", [InitErrorDetails(type=rule, loc=(k, "start"), input=None)]
+                )
+        return value
+
+    @field_validator("door_open_s")
+    @classmethod
+    def _door_within_service(cls, value: float, info: ValidationInfo) -> float:
+        if "service_time_s" in info.data and value > info.data["service_time_s"]:
+            raise ValueError("door_open_s must not exceed service_time_s")
+        return value
+
+
+#: Longest leg a matrix may hold: 100,000 km and 30 days (beyond, the numbers are mistakes).
+MAX_MATRIX_DISTANCE_M = 1e8
+MAX_MATRIX_DURATION_S = 30 * 86_400.0
+
+
+class RoadMatrix(Params):
+    """Distances and durations from the client's road router: depot first, then the stops in
+    request order."""
+
+    distances_m: list[list[Annotated[float, Field(ge=0, le=MAX_MATRIX_DISTANCE_M)]]] = Field(
+        ..., description="Road distance of each pair [m], 0–100,000 km."
+    )
+    durations_s: list[list[Annotated[float, Field(ge=0, le=MAX_MATRIX_DURATION_S)]]] = Field(
+        ..., description="Driving time of each pair [s], 0–30 days."
+    )
+    street_types: list[list[StreetTypeName]] | None = Field(
+        None, description="Street type of each pair; null chooses by leg length."
+    )
+
+
+Objective = Literal["distance", "duration", "energy"]

@@ -1,0 +1,322 @@
+"""The van: longitudinal dynamics and the cab (paper §2.1, §2.3), the cargo box and its
+refrigeration unit (§3), the traction battery."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, ValidationInfo, field_validator
+
+from core.params.base import Params
+
+
+class VehicleParams(Params):
+    """The van: longitudinal dynamics (paper §2.1) and the cab's consumers (§2.3)."""
+
+    mass_kg: float = Field(
+        1680.0, gt=0, le=40_000, description="Empty vehicle mass incl. driver [kg] (Table 1 m)."
+    )
+    drag_coefficient: float = Field(
+        0.329, gt=0, le=2, description="Aerodynamic drag coefficient c_d [–] (Table 1)."
+    )
+    frontal_area_m2: float = Field(
+        4.27, gt=0, le=20, description="Frontal area A_f [m²] (Table 1)."
+    )
+    rolling_resistance_coefficient: float = Field(
+        0.012, ge=0, le=0.1, description="Rolling-resistance coefficient c_r [–] (Table 1)."
+    )
+    rolling_resistance_factor: float = Field(
+        1.25,
+        gt=0,
+        le=3,
+        description="Factor on m·g·c_r in the rolling force [–]; 1.25 is the paper's eq. 4.",
+    )
+    drivetrain_efficiency: float = Field(
+        0.85,
+        ge=0.1,
+        le=1,
+        description="Battery-to-wheel efficiency when motoring η_el [–] (eq. 7); 0.85 is the "
+        "typical BEV figure NREL FASTSim uses.",
+    )
+    regen_efficiency: float = Field(
+        0.6,
+        ge=0,
+        le=1,
+        description="Share of braking power at the wheels returned to the battery [–]; "
+        "0 disables regeneration. 0.6 is a conservative van figure (FASTSim's Zoe: 0.773).",
+    )
+    max_regen_power_w: float | None = Field(
+        None, gt=0, le=1_000_000, description="Cap on regenerated electric power [W]; none if null."
+    )
+    max_motor_power_w: float | None = Field(
+        None,
+        gt=0,
+        le=1_000_000,
+        description="Cap on the drive's mechanical power at the wheels [W]; none if null (the "
+        "paper's model). A trace that asks for more is followed as closely as the cap allows: "
+        "the van falls behind and catches up, so no energy is lost or invented.",
+    )
+    max_acceleration_mps2: float = Field(
+        2.0,
+        ge=0.1,
+        le=10,
+        description="Maximum acceleration v̇_max [m/s²] (§2.2); 2.0 ≈ 0–100 km/h in 14 s.",
+    )
+    air_density_kg_m3: float = Field(
+        1.2, gt=0, le=2, description="Air density ρ for drag [kg/m³] (eq. 3); 1.2 at 20 °C."
+    )
+    auxiliaries_power_w: float = Field(
+        400.0,
+        ge=0,
+        le=20_000,
+        description="Constant auxiliaries (lights, radio, controls) [W]; 400 is the paper's §2.3.",
+    )
+    cabin_hvac_enabled: bool = Field(
+        True, description="Heat or cool the cab to 20 °C (paper Table 2); false switches it off."
+    )
+    cab_hvac_at_stops: Literal["on", "off", "reduced"] = Field(
+        "on",
+        description="Cab heating/air conditioning while parked at a stop: 'on' holds 20 °C (the "
+        "paper's assumption), 'off' lets the cab drift towards the outside air, 'reduced' runs at "
+        "cab_reduced_share of the power. After the stop the HVAC brings the cab back to 20 °C.",
+    )
+    cab_reduced_share: float = Field(
+        0.5,
+        ge=0,
+        le=1,
+        description="Share of the Table 2 power the cab HVAC draws while parked in 'reduced' [–].",
+    )
+    cab_recovery_energy_j_k: float = Field(
+        60_000.0,
+        gt=0,
+        le=1_000_000,
+        description="Electric energy to move the cab's temperature by one kelvin [J/K]: its "
+        "thermal mass (air ≈ 4 kJ/K plus seats, dashboard and trim) over a heater efficiency of "
+        "1. With the Table 2 power it sets how fast a parked cab drifts (time constant = this "
+        "value × |20 °C − outside| / Table 2 power).",
+    )
+    cab_hvac_max_power_w: float = Field(
+        6000.0,
+        gt=0,
+        le=50_000,
+        description="Most electric power of the cab HVAC [W]: how fast it brings the cab back "
+        "after a stop or a departure with a cold or hot cab.",
+    )
+
+
+class CargoBoxParams(Params):
+    """The insulated cargo box and its refrigeration unit (paper §3)."""
+
+    volume_m3: float = Field(8.0, ge=0.1, le=100, description="Inner volume V [m³] (Table 1).")
+    wall_heat_transfer_w_m2k: float = Field(
+        2.172,
+        gt=0,
+        le=20,
+        description="Wall heat-transfer coefficient α [W/(m²·K)] (Table 1, eq. 11).",
+    )
+    roof_area_m2: float = Field(8.0, gt=0, le=100, description="Roof area A_r [m²] (Table 1).")
+    side_area_m2: float = Field(
+        4.182, gt=0, le=100, description="Area of one side wall A_s [m²] (Table 1)."
+    )
+    back_area_m2: float = Field(
+        3.12, gt=0, le=100, description="Back wall area A_b [m²] (Table 1)."
+    )
+    wall_area_m2: float | None = Field(
+        None,
+        gt=0,
+        le=500,
+        description="Total heat-transfer area A [m²] (eq. 11); null means 2·(A_r + A_s + A_b).",
+    )
+    setpoint_c: float = Field(
+        4.0, ge=-40, le=25, description="Cargo-air set-point ϑ_CB [°C]; 4 °C for chilled goods."
+    )
+    cop: float = Field(
+        1.5,
+        ge=0.1,
+        le=10,
+        description="Coefficient of performance of the refrigeration unit η_RU [–] (eq. 12), "
+        "used when cop_model is 'constant'; 1.5 is typical of small electric units at 30 °C "
+        "ambient, chilled box.",
+    )
+    cop_model: Literal["constant", "carnot"] = Field(
+        "constant",
+        description="'constant': the paper's η_RU (cop). 'carnot': a fraction of the Carnot COP "
+        "between an evaporator below the box and a condenser above the outside air, so the unit "
+        "works harder on hot days and for frozen goods (see core.physics.cargo.refrigeration_cop).",
+    )
+    carnot_fraction: float = Field(
+        0.3,
+        ge=0.05,
+        le=1,
+        description="Share of the Carnot COP the unit reaches [–] ('carnot' model). 0.3 is fitted "
+        "to the paper's η_RU = 1.5 at 30 °C outside / 4 °C box (COP 1.57) and gives 0.97 at "
+        "30 °C / −20 °C, within the 0.5–1.5 that Tassou, De-Lille & Ge (2009, Appl. Therm. Eng. "
+        "29) report for transport units.",
+    )
+    evaporator_approach_k: float = Field(
+        10.0, ge=0, le=40, description="Evaporator below the box air [K] ('carnot' model)."
+    )
+    condenser_approach_k: float = Field(
+        15.0, ge=0, le=40, description="Condenser above the outside air [K] ('carnot' model)."
+    )
+    standby_power_w: float = Field(
+        0.0,
+        ge=0,
+        le=5000,
+        description="Draw of the unit's controls and evaporator fans whenever it runs [W]; 0 in "
+        "the paper.",
+    )
+    structure_heat_capacity_j_k: float = Field(
+        190_000.0,
+        gt=0,
+        le=10_000_000,
+        description="Heat capacity of the box structure that follows the cargo air [J/K]: the "
+        "inner GRP liner (2 mm, 1850 kg/m³, 1000 J/(kg·K)) and half the polyurethane foam "
+        "(80 mm, 40 kg/m³, 1500 J/(kg·K)) over the 30.6 m² of the paper's box ≈ 187 kJ/K. "
+        "Dynamic mode, and the pull-down of a box that was not pre-cooled.",
+    )
+    solar_absorptivity: float = Field(
+        0.3,
+        ge=0,
+        le=1,
+        description="Solar absorptivity of the box's outer surface [–]; 0.3 for white paint.",
+    )
+    outside_film_coefficient_w_m2k: float = Field(
+        22.7,
+        gt=0,
+        le=200,
+        description="Outside surface film coefficient h_o [W/(m²·K)]: the share α/h_o of the "
+        "absorbed sun that crosses the wall (sol-air method, ASHRAE Fundamentals ch. 18).",
+    )
+    shadow_factor: float = Field(
+        0.8,
+        ge=0,
+        le=1,
+        description="Shadow factor b_sh [–] (eq. 17); 1 is full sun, 0.8 a partly shaded street.",
+    )
+    door_width_m: float = Field(1.2, gt=0, le=5, description="Door opening width W [m].")
+    door_height_m: float = Field(1.5, gt=0, le=5, description="Door opening height H [m].")
+    doorway_flow_factor: float = Field(
+        0.25,
+        gt=0,
+        le=1.5,
+        description="Doorway flow factor D_f [–] of the Gosney–Olama infiltration model, "
+        "calibrated so that 10 min open at 30 K costs about two hours of wall gain of an "
+        "ATP-class box (≈0.7 kWh; see core.physics.cargo).",
+    )
+    curtain_effectiveness: float = Field(
+        0.0, ge=0, lt=1, description="Effectiveness E of a door curtain [–]; strips ≈ 0.9."
+    )
+    cargo_specific_heat_j_kgk: float = Field(
+        2300.0,
+        gt=0,
+        le=10_000,
+        description="Specific heat of the cargo c_p [J/(kg·K)] (Table 1: 2.3 kJ/(kg·K)).",
+    )
+    mode: Literal["steady", "dynamic"] = Field(
+        "steady",
+        description="'steady': the paper's assumption, box at set-point, unit covers every load. "
+        "'dynamic': box temperature integrated with a finite unit capacity.",
+    )
+    refrigeration_capacity_w: float = Field(
+        3000.0,
+        gt=0,
+        le=100_000,
+        description="Cooling capacity of the unit Q_0,max [W] (dynamic mode only).",
+    )
+    product_limit_c: float = Field(
+        7.0,
+        ge=-40,
+        le=40,
+        description="Highest cargo-air temperature the product tolerates [°C] (dynamic mode).",
+    )
+    heater_enabled: bool = Field(
+        False,
+        description="When the box loses heat (outside colder than the set-point), heat it to hold "
+        "the set-point (chilled produce must not freeze). The paper's van has no heater.",
+    )
+    heating_cop: float = Field(
+        1.0,
+        ge=0.5,
+        le=6,
+        description="Heat delivered per electric energy when the box is heated [–]: 1 for an "
+        "electric or hot-gas heater, 2–3 for a reversible heat pump.",
+    )
+    heating_capacity_w: float = Field(
+        2000.0,
+        gt=0,
+        le=100_000,
+        description="Most heat the box heater delivers [W] (dynamic mode only).",
+    )
+
+    @field_validator("product_limit_c")
+    @classmethod
+    def _limit_above_setpoint(cls, value: float, info: ValidationInfo) -> float:
+        if "setpoint_c" in info.data and value <= info.data["setpoint_c"]:
+            raise ValueError("product_limit_c must be above setpoint_c")
+        return value
+
+    @property
+    def heat_transfer_area_m2(self) -> float:
+        """Wall area A [m²] used in eq. 11."""
+        if self.wall_area_m2 is not None:
+            return self.wall_area_m2
+        return 2.0 * (self.roof_area_m2 + self.side_area_m2 + self.back_area_m2)
+
+
+#: Smallest usable state-of-charge window ``initial_soc − min_soc`` [–].
+MIN_SOC_WINDOW = 0.01
+
+
+class BatteryParams(Params):
+    """Traction battery as seen by the energy balance."""
+
+    usable_capacity_kwh: float = Field(
+        40.0, ge=0.1, le=2000, description="Usable battery capacity [kWh]."
+    )
+    initial_soc: float = Field(1.0, gt=0, le=1, description="State of charge at departure [–].")
+    min_soc: float = Field(
+        0.1, ge=0, lt=1, description="Reserve: lowest acceptable state of charge [–]."
+    )
+    temperature_derating: bool = Field(
+        False,
+        description="Derate the battery in cold and heat: less usable energy and more energy per "
+        "km of every consumer, from AAA's 2019 dynamometer tests of five EVs with HVAC off "
+        "(see core.physics.battery). False: the paper's temperature-independent battery.",
+    )
+    charging_efficiency: float = Field(
+        0.9,
+        ge=0.5,
+        le=1,
+        description="Energy stored per energy drawn from the grid when charging [–]; sets the "
+        "energy to recharge at the plug.",
+    )
+
+    @field_validator("min_soc")
+    @classmethod
+    def _reserve_below_start(cls, value: float, info: ValidationInfo) -> float:
+        if "initial_soc" in info.data and value > info.data["initial_soc"] - MIN_SOC_WINDOW:
+            raise ValueError(f"min_soc must be at least {MIN_SOC_WINDOW} below initial_soc")
+        return value
+
+
+class VanParams(Params):
+    """Everything about the van that a simulation needs."""
+
+    vehicle: VehicleParams = Field(
+        default_factory=VehicleParams, description="Longitudinal dynamics and cab consumers."
+    )
+    cargo_box: CargoBoxParams = Field(
+        default_factory=CargoBoxParams, description="Cargo box and refrigeration unit."
+    )
+    battery: BatteryParams = Field(default_factory=BatteryParams, description="Traction battery.")
+    payload_kg: float = Field(
+        550.0, ge=0, le=40_000, description="Payload at departure [kg] (Table 1: 550 kg)."
+    )
+    precondition_at_depot: bool = Field(
+        True,
+        description="Bring the cab to 20 °C and the box structure to its set-point on grid power "
+        "before departure (reported as grid_kwh, not taken from the battery). False: the van "
+        "leaves with the cab and the box structure at the outside temperature and the battery "
+        "pays for the pull-down.",
+    )

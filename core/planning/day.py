@@ -1,0 +1,197 @@
+"""The day as a fleet search sees it, fixed for the whole search: the vans and their shifts in
+seconds after the day's first departure, each place's windows, service and demand in the
+solver's units, the arcs that exist, and each van's estimates (:class:`FleetDay`); and how one
+van's route is simulated (:func:`simulate_van`)."""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from core.arrays import FloatArray
+from core.clock import at
+from core.exceptions import NoRouteError
+from core.params import Depot
+from core.planning.estimates import VanEstimates, van_estimates
+from core.planning.model import MAX_ROUND_S, PlanProblem, PlanResult, Solved, place_field
+from core.planning.scene import Scene
+from core.planning.timeline import windows_after
+from core.planning.verify import simulate_route
+from core.routing.geo import Legs
+from core.routing.roads import LegRoute, RoadRouter
+from core.routing.units import payload_units_up
+
+
+@dataclass(frozen=True)
+class VanShift:
+    """One van as the search sees it: its round (van, stops, conditions), its earliest
+    departure, its latest return (None: the planner's longest round) and whether its battery is
+    a constraint (a fleet's vans) or only reported (a single round)."""
+
+    id: str
+    problem: PlanProblem
+    start: dt.datetime
+    end: dt.datetime | None
+    battery_enforced: bool = True
+
+
+def leg_roads(router: RoadRouter, places: list[Depot], order: list[int]) -> list[LegRoute]:
+    """The router's road of every leg of ``order``; a leg with no road names its destination."""
+    roads = []
+    for i, j in itertools.pairwise(order):
+        try:
+            roads.append(router.route(places[i], places[j]))
+        except NoRouteError as error:
+            raise NoRouteError(error.message, place_field(j)) from None
+    return roads
+
+
+@dataclass(frozen=True)
+class FleetDay:
+    """The fixed facts of one fleet search; times in seconds after ``reference``.
+
+    Attributes
+    ----------
+    scene
+        The places, their legs, the zone and the weather.
+    router
+        For the roads of the legs driven (OSRM), or None.
+    shifts
+        The vans.
+    reference
+        The day's first departure.
+    shift_s
+        Each van's earliest departure and latest return [s].
+    horizon_s
+        The latest return of any van [s].
+    windows_s
+        Each place's time windows [s] (the depot's none).
+    service_s, demand_g
+        Each place's service time [s] and delivery [g] (the depot's 0).
+    finite, duration_s
+        Which arcs have a road, and the matrix's driving time (0 where none) [s].
+    unreachable
+        Places with no road from or to the depot.
+    estimates
+        Each van's estimates (vans of one kind share them).
+    """
+
+    scene: Scene
+    router: RoadRouter | None
+    shifts: list[VanShift]
+    reference: dt.datetime
+    shift_s: list[tuple[float, float]]
+    horizon_s: int
+    windows_s: list[list[tuple[float, float]]]
+    service_s: FloatArray
+    demand_g: NDArray[np.int64]
+    finite: NDArray[np.bool_]
+    duration_s: FloatArray
+    unreachable: frozenset[int]
+    estimates: list[VanEstimates]
+
+    @property
+    def n(self) -> int:
+        """Places, the depot included."""
+        return len(self.scene.places)
+
+    @property
+    def vans(self) -> range:
+        return range(len(self.shifts))
+
+    def clock(self, seconds: float) -> str:
+        """A moment of the day as local HH:MM ("never" for infinity)."""
+        if not math.isfinite(seconds):
+            return "never"
+        return f"{at(self.reference, seconds):%H:%M}"
+
+    def simulate(self, v: int, route: list[int]) -> PlanResult:
+        """The full simulation of van ``v`` driving ``route`` (stops; the depot around it)."""
+        return simulate_van(self, v, route)
+
+
+def fleet_day(shifts: list[VanShift], scene: Scene, router: RoadRouter | None) -> FleetDay:
+    """The day of ``shifts`` on ``scene``: the shared facts and each kind of van's estimates."""
+    base = shifts[0].problem
+    reference = min(shift.start for shift in shifts)
+    origin = reference.timestamp()
+    shift_s = [
+        (
+            shift.start.timestamp() - origin,
+            (shift.end or at(shift.start, MAX_ROUND_S)).timestamp() - origin,
+        )
+        for shift in shifts
+    ]
+    legs = scene.legs
+    finite = np.isfinite(legs.duration_s) & np.isfinite(legs.distance_m)
+    service_s = np.array([0.0] + [math.ceil(s.service_time_s) for s in base.stops])
+    solver_legs = _long_where_no_road(legs, finite)
+    kinds: dict[str, VanEstimates] = {}
+    estimates = []
+    for shift in shifts:
+        key = f"{shift.problem.van.model_dump_json()}@{shift.start.isoformat()}"
+        if key not in kinds:
+            kinds[key] = van_estimates(
+                shift.problem, solver_legs, shift.start, base.stops, service_s
+            )
+        estimates.append(kinds[key])
+    return FleetDay(
+        scene=scene,
+        router=router,
+        shifts=shifts,
+        reference=reference,
+        shift_s=shift_s,
+        horizon_s=math.floor(max(end for _, end in shift_s)),
+        windows_s=windows_after(base.stops, base.date, reference),
+        service_s=service_s,
+        demand_g=np.concatenate(([0], payload_units_up([s.delivery_kg for s in base.stops]))),
+        finite=finite,
+        duration_s=np.where(finite, legs.duration_s, 0.0),
+        unreachable=frozenset(legs.unreachable()),
+        estimates=estimates,
+    )
+
+
+def _long_where_no_road(legs: Legs, finite: NDArray[np.bool_]) -> Legs:
+    """The legs with the arcs that have no road made long (the solver never picks them)."""
+    if finite.all():
+        return legs
+    far_m = float(np.nanmax(legs.distance_m)) * 10 + 1e6
+    far_s = float(np.nanmax(legs.duration_s)) * 10 + 1e5
+    return Legs(
+        distance_m=np.where(finite, legs.distance_m, far_m),
+        duration_s=np.where(finite, legs.duration_s, far_s),
+        grade=legs.grade,
+        street_type=legs.street_type,
+        source=legs.source,
+        snap_distance_m=legs.snap_distance_m,
+    )
+
+
+def simulate_van(day: FleetDay, v: int, route: list[int]) -> PlanResult:
+    """The full simulation of van ``v`` driving ``route``: windows from its own departure,
+    the router's roads when the legs came from it, back by its shift's end."""
+    shift = day.shifts[v]
+    order = [0, *route, 0]
+    origin = day.reference.timestamp() - shift.start.timestamp()
+    windows = [[(a + origin, b + origin) for a, b in place] for place in day.windows_s]
+    roads = (
+        leg_roads(day.router, day.scene.places, order)
+        if day.router is not None and day.scene.legs.source == "osrm"
+        else None
+    )
+    return simulate_route(
+        shift.problem,
+        day.scene,
+        order,
+        shift.start,
+        roads,
+        Solved("feasible", day.estimates[v].route_cost(route), 0.0),
+        windows,
+        None if shift.end is None else shift.end.timestamp() - shift.start.timestamp(),
+    )

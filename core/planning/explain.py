@@ -1,0 +1,62 @@
+"""Why a stop is left out: no road, a rule that stops every van even on a round of its own, the
+simulation that made it go, or the rule that keeps it from joining any van's route."""
+
+from __future__ import annotations
+
+from collections import Counter
+
+from core.planning.feasibility import Feasibility
+from core.planning.model import Unassigned, UnassignedReason
+from core.planning.verify import Failure
+
+#: Which reason names a stop that vans refuse for different reasons, when as many refuse it for
+#: each.
+REASON_ORDER: tuple[UnassignedReason, ...] = ("capacity", "time_window", "shift", "battery")
+_FULL_DETAIL: dict[UnassignedReason, str] = {
+    "capacity": "the fleet is full: no van has payload left for it",
+    "battery": "the fleet's batteries are spent: on any van's route it would take the charge "
+    "below the reserve",
+    "time_window": "no van can reach it inside its windows alongside its other stops",
+    "shift": "no van's shift has time left for it alongside its other stops",
+}
+
+
+def _most_shared(counts: Counter[UnassignedReason]) -> UnassignedReason:
+    """The reason most vans give (ties: the first of :data:`REASON_ORDER`)."""
+    return max(REASON_ORDER, key=lambda r: (counts[r], -REASON_ORDER.index(r)))
+
+
+def explain(
+    rules: Feasibility, node: int, failure: Failure | None, routes: list[list[int]]
+) -> Unassigned:
+    """Why the stop at ``node`` is not served: ``failure`` if the simulation removed it,
+    ``routes`` the vans' final routes."""
+    day = rules.day
+    stop_id = day.scene.places[node].id
+    if node in day.unreachable:
+        depot = day.scene.places[0].id
+        return Unassigned(stop_id, "unreachable", f"no road links it with the depot '{depot}'")
+    alone = [rules.alone(v, node) for v in day.vans]
+    if all(why is not None for why in alone):
+        refusals = [why for why in alone if why is not None]
+        reason = _most_shared(Counter(why.reason for why in refusals))
+        return Unassigned(stop_id, reason, next(w.detail for w in refusals if w.reason == reason))
+    if failure is not None:
+        return Unassigned(stop_id, failure.reason, f"left out after simulation: {failure.detail}")
+    return Unassigned(stop_id, *_full(rules, node, routes))
+
+
+def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[UnassignedReason, str]:
+    """A stop some van could serve on a round of its own, left out because the fleet is full:
+    the rule that stops it from joining any van's route at its best place, the one most vans
+    share."""
+    refusals: Counter[UnassignedReason] = Counter()
+    for v, route in enumerate(routes):
+        options = [
+            rules.violations(v, [*route[:k], node, *route[k:]]) for k in range(len(route) + 1)
+        ]
+        refusals.update(min(options, key=len)[:1])
+    if not refusals:
+        return "shift", "the search ended (time limit) before it found a route for it"
+    reason = _most_shared(refusals)
+    return reason, _FULL_DETAIL[reason]

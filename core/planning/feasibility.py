@@ -1,0 +1,115 @@
+"""What the solver's current estimates say a van can do: the rules a route breaks
+(:meth:`Feasibility.violations`) and why a stop cannot be served even on a round of its own
+(:meth:`Feasibility.alone`)."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from core.clock import at
+from core.physics.battery import JOULES_PER_KWH
+from core.planning.day import FleetDay
+from core.planning.model import UnassignedReason
+from core.planning.timeline import next_window
+from core.planning.verify import Failure
+from core.routing.units import payload_units_down
+
+
+@dataclass(frozen=True)
+class Feasibility:
+    """The rules as the estimates see them now: the driving times learned so far and each
+    van's energy budget [J] (``None`` where the battery is only reported)."""
+
+    day: FleetDay
+    travel_s: NDArray[np.int64]
+    budgets_j: Sequence[float | None]
+
+    def violations(self, v: int, route: Sequence[int]) -> list[UnassignedReason]:
+        """The rules van ``v`` breaks on ``route`` (stops; the depot around it)."""
+        day = self.day
+        broken: list[UnassignedReason] = []
+        payload = payload_units_down(day.shifts[v].problem.van.payload_kg)
+        if float(day.demand_g[list(route)].sum()) > payload:
+            broken.append("capacity")
+        budget = self.budgets_j[v]
+        if budget is not None and day.estimates[v].route_energy_j(route) > budget:
+            broken.append("battery")
+        clock, end = day.shift_s[v]
+        for i, j in itertools.pairwise([0, *route, 0]):
+            clock += day.service_s[i] + self.travel_s[i, j]
+            if j == 0:
+                break
+            window = next_window(clock, day.windows_s[j])
+            if window is None:
+                broken.append("time_window")
+                return broken
+            clock = max(clock, window[0])
+        if clock > end:
+            broken.append("shift")
+        return broken
+
+    def alone(self, v: int, node: int) -> Failure | None:
+        """Why van ``v`` could not serve the stop at ``node`` even on a round of its own, if it
+        could not."""
+        day = self.day
+        stop = day.shifts[v].problem.stops[node - 1]
+        payloads = [shift.problem.van.payload_kg for shift in day.shifts]
+        if stop.delivery_kg > payloads[v]:
+            return Failure(
+                "capacity",
+                node,
+                f"it takes {stop.delivery_kg:g} kg; no van carries that much (largest payload "
+                f"{max(payloads):g} kg)",
+            )
+        start_s, end_s = day.shift_s[v]
+        window = next_window(start_s + self.travel_s[0, node], day.windows_s[node])
+        if window is None:
+            latest = at(day.reference, day.windows_s[node][-1][1])
+            return Failure(
+                "time_window",
+                node,
+                f"the earliest any van gets there is {day.clock(self.earliest(node))}, "
+                f"after its last window closes at {latest:%H:%M}",
+            )
+        if self._back_s(start_s, node) > end_s:
+            return Failure(
+                "shift",
+                node,
+                "even on a round of its own no van would be back before its shift ends "
+                f"(earliest return {day.clock(self.earliest_back(node))})",
+            )
+        budget = self.budgets_j[v]
+        need_j = day.estimates[v].route_energy_j([node])
+        if budget is not None and need_j > budget:
+            most_j = max(b for b in self.budgets_j if b is not None)
+            return Failure(
+                "battery",
+                node,
+                f"a round to it alone needs about {need_j / JOULES_PER_KWH:.1f} kWh; the "
+                f"most any van has above its reserve is about {most_j / JOULES_PER_KWH:.1f} "
+                "kWh",
+            )
+        return None
+
+    def _back_s(self, start_s: float, node: int) -> float:
+        """Return to the depot of a round to ``node`` alone leaving at ``start_s`` [s];
+        infinite when its windows have all closed."""
+        window = next_window(start_s + self.travel_s[0, node], self.day.windows_s[node])
+        if window is None:
+            return math.inf
+        serve = max(start_s + self.travel_s[0, node], window[0])
+        return serve + self.day.service_s[node] + self.travel_s[node, 0]
+
+    def earliest(self, node: int) -> float:
+        """The earliest any van reaches ``node`` [s]."""
+        return min(start + self.travel_s[0, node] for start, _ in self.day.shift_s)
+
+    def earliest_back(self, node: int) -> float:
+        """The earliest any van is back from a round to ``node`` alone [s]."""
+        return min(self._back_s(start, node) for start, _ in self.day.shift_s)

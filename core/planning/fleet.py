@@ -1,0 +1,303 @@
+"""Fleet planning: the day's stops split across several vans from one depot, with delivery time
+windows, shifts, payload and the battery as constraints — and every returned route verified by
+the full simulation of its day.
+
+1. The solver (:mod:`core.routing.vrp`) plans with estimates (:mod:`core.planning.estimates`):
+   each arc's driving time, and its energy as traction by the arc's distance and grade for the
+   van's mass plus the standing loads (auxiliaries, cab, box) times its duration, with each
+   stop's service and door openings; the usable battery energy between departure charge and
+   reserve is the van's budget.
+2. Each route is driven and simulated in full (:mod:`core.planning.verify`: traction,
+   auxiliaries, cab, refrigeration with the door openings, at the time of day each leg is
+   really driven). A route that breaks a rule — its charge below the reserve, a window missed,
+   back after its shift — tightens the estimate that misled the solver (that van's energy
+   budget by the simulated shortfall; the driving times of the arcs driven, exactly, and of the
+   others by the ratio seen) and the fleet is solved again from the routes that held, within
+   the time budget.
+3. Whatever still fails when the budget is spent loses stops, one at a time, until its
+   simulation holds (:mod:`core.planning.repair`). A stop no van can serve is listed with its
+   reason (:mod:`core.planning.explain`) — never a route reported feasible that the simulation
+   says is not.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from core.clock import check_representable, departure
+from core.exceptions import CoreError, InvalidParameterError
+from core.physics.simulate import CONSUMERS
+from core.physics.weather import WeatherService, forecast_for
+from core.planning.day import FleetDay, VanShift, fleet_day, leg_roads
+from core.planning.estimates import LearnedTimes
+from core.planning.explain import explain
+from core.planning.feasibility import Feasibility
+from core.planning.model import (
+    FleetProblem,
+    FleetResult,
+    FleetRoute,
+    PlanProblem,
+    PlanResult,
+    RoundFields,
+    Unassigned,
+    check_stop_ids,
+    fields_of,
+)
+from core.planning.repair import Repaired, fitting, repair
+from core.planning.scene import Scene, legs_for
+from core.planning.solver_input import routing_input
+from core.planning.timeline import drive_time_s
+from core.planning.verify import Failure, route_failure, traced_seconds
+from core.routing.geo import build_legs
+from core.routing.roads import RememberingRouter, RoadRouter
+from core.routing.vrp import solve_routes
+
+#: Share of the remaining budget one solve may take (the rest verifies and re-solves).
+SOLVE_SHARE = 0.9
+#: Budget below which no new solve starts [s].
+MIN_SOLVE_S = 0.05
+#: A tightened energy budget is cut this much below the simulated need, so the next
+#: solution does not land on the edge again.
+TIGHTEN_MARGIN = 0.98
+#: Stops whose arcs are driven before the first solve to learn the simulation's driving times.
+CALIBRATION_STOPS = 12
+
+
+def plan_fleet(
+    problem: FleetProblem,
+    router: RoadRouter | None = None,
+    weather_service: WeatherService | None = None,
+) -> FleetResult:
+    """Split the stops across the fleet, order each van's stops and verify every route by the
+    full simulation of its day.
+
+    Parameters
+    ----------
+    problem
+        The fleet and the day's stops.
+    router
+        A road router for the matrix and the roads, as in :func:`core.planning.round.plan`.
+    weather_service
+        An hourly forecast for the day, as in :func:`core.planning.round.plan`.
+    """
+    started = time.perf_counter()
+    shifts, timezone_name = check_fleet(problem)
+    legs = legs_for(problem, router)
+    first = min(shift.start for shift in shifts)
+    last = max(shift.end for shift in shifts if shift.end is not None)
+    # One forecast for the whole day, shared by every van.
+    day_weather = forecast_for(
+        problem.weather,
+        weather_service,
+        problem.depot.lat,
+        problem.depot.lon,
+        first,
+        last.timestamp() - first.timestamp() + 2 * 3600.0,
+    )
+    scene = Scene(problem.places, legs, timezone_name, lambda _begin, _span_s: day_weather)
+    remembering = None if router is None else RememberingRouter(router)
+    routed = search(
+        fleet_day(shifts, scene, remembering),
+        problem.minimize_vehicles,
+        started + problem.time_limit_s,
+    )
+    routes = routed.stamped(time.perf_counter() - started)
+    plans = [route.plan for route in routes]
+    return FleetResult(
+        routes=routes,
+        unassigned=routed.unassigned,
+        distance_m=sum(p.distance_m for p in plans),
+        duration_s=sum(p.duration_s for p in plans),
+        energy_kwh={name: sum(p.energy_kwh[name] for p in plans) for name in (*CONSUMERS, "total")},
+        grid_kwh=sum(p.grid_kwh for p in plans),
+        vehicles_used=len(plans),
+        objective=problem.objective,
+        objective_value=routed.objective_value,
+        runtime_s=time.perf_counter() - started,
+        verification_rounds=routed.verification_rounds,
+        timezone=timezone_name,
+        distance_source=legs.source,
+        warnings=list(day_weather[1]),
+    )
+
+
+def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
+    """Everything about a fleet plan that can be checked without solving it: unique ids of
+    stops and vans, each shift's start and end on the day in the zone, the client's matrix.
+    Raises :class:`core.exceptions.CoreError` naming the field; returns each van's shift and
+    the zone's name."""
+    check_stop_ids(problem.depot, problem.stops)
+    vans: dict[str, int] = {}
+    for index, vehicle in enumerate(problem.vehicles):
+        if vehicle.id in vans:
+            raise InvalidParameterError(
+                f"vehicle id '{vehicle.id}' is used twice (also by vehicles[{vans[vehicle.id]}])"
+                "; ids must be unique",
+                f"vehicles[{index}].id",
+            )
+        vans[vehicle.id] = index
+    timezone_name = ""
+    shifts = []
+    for index, vehicle in enumerate(problem.vehicles):
+        ends = []
+        for name in ("shift_start", "shift_end"):
+            try:
+                moment, timezone_name = departure(
+                    problem.date, getattr(vehicle, name), problem.timezone, problem.depot.lon
+                )
+            except CoreError as error:
+                if error.field != "start_time":  # the zone: the request's, not the van's
+                    raise
+                raise error.at(f"vehicles[{index}].{name}") from None
+            ends.append(moment)
+        check_representable(ends[1], 86_400.0, "date")
+        round_problem = PlanProblem(
+            **fields_of(problem, RoundFields),
+            start_time=vehicle.shift_start,
+            time_limit_s=problem.time_limit_s,
+            van=vehicle.van,
+        )
+        shifts.append(VanShift(vehicle.id, round_problem, ends[0], ends[1]))
+    if problem.matrix is not None:
+        build_legs(problem.places, problem.matrix)
+    return shifts, timezone_name
+
+
+@dataclass(frozen=True)
+class Routed:
+    """What a search found: the verified routes, the stops left out, the rounds of
+    verification and the objective's estimated value over the routes."""
+
+    routes: list[FleetRoute]
+    unassigned: list[Unassigned]
+    verification_rounds: int
+    objective_value: float
+
+    def stamped(self, runtime_s: float) -> list[FleetRoute]:
+        """The routes with the search's whole run time [s] on each plan."""
+        return [
+            replace(r, plan=replace(r.plan, solved=replace(r.plan.solved, runtime_s=runtime_s)))
+            for r in self.routes
+        ]
+
+
+def calibrate(day: FleetDay, times: LearnedTimes) -> None:
+    """Drive a sample of arcs as the simulation will (out of the depot, and on to each
+    sampled stop's nearest neighbour) and learn their times before the first solve. A client's
+    matrix is driven as it says."""
+    if day.scene.legs.source == "client":
+        return
+    reachable = [k for k in range(1, day.n) if k not in day.unreachable]
+    sample = reachable[:: max(len(reachable) // CALIBRATION_STOPS, 1)][:CALIBRATION_STOPS]
+    arcs = []
+    for k in sample:
+        arcs.append((0, k))
+        onward = np.where(day.finite[k], day.duration_s[k], np.inf)
+        onward[[0, k]] = np.inf
+        if np.isfinite(onward).any():
+            arcs.append((k, int(np.argmin(onward))))
+    problem, places = day.shifts[0].problem, day.scene.places
+    driven = []
+    for i, j in arcs:
+        road = (
+            leg_roads(day.router, places, [i, j])[0]
+            if day.router is not None and day.scene.legs.source == "osrm"
+            else None
+        )
+        driven.append(((i, j), drive_time_s(problem, day.scene.legs, i, j, road)))
+    times.learn(driven)
+
+
+def _failure(day: FleetDay, v: int, result: PlanResult) -> Failure | None:
+    shift = day.shifts[v]
+    return route_failure(
+        shift.id, shift.problem, day.scene.places, result, shift.end, shift.battery_enforced
+    )
+
+
+def _tightened(budget_j: float | None, result: PlanResult) -> float | None:
+    """A van's energy budget after its simulation ran below the reserve: cut by the share of
+    the capacity it would have needed."""
+    if budget_j is None:
+        return None
+    battery = result.battery
+    need = max(battery.required_capacity_kwh, 1e-9)
+    return budget_j * min(battery.usable_capacity_kwh / need, 1.0) * TIGHTEN_MARGIN
+
+
+def _repair(day: FleetDay, v: int, route: list[int], failure: Failure) -> Repaired:
+    """Van ``v``'s route stripped of stops until its simulation holds."""
+
+    def simulate(stops: list[int]) -> PlanResult:
+        return day.simulate(v, stops)
+
+    def check(_stops: list[int], result: PlanResult) -> Failure | None:
+        return _failure(day, v, result)
+
+    return repair(route, failure, simulate, check, day.estimates[v])
+
+
+def search(day: FleetDay, minimize_vehicles: bool, deadline: float) -> Routed:
+    """Solve and verify until every route holds or ``deadline`` (a ``time.perf_counter``
+    value); ``minimize_vehicles``: fewer vans first, then the objective."""
+    times = LearnedTimes(day.duration_s, day.finite, day.horizon_s)
+    calibrate(day, times)
+    budgets = [
+        e.budget_j if shift.battery_enforced else None
+        for shift, e in zip(day.shifts, day.estimates, strict=True)
+    ]
+    routes: list[list[int]] = [[] for _ in day.vans]
+    results: dict[int, PlanResult] = {}
+    failures: dict[int, Failure] = {}
+    initial: list[list[int]] | None = None
+    rounds = 0
+    while True:
+        remaining = deadline - time.perf_counter()
+        if rounds and remaining < MIN_SOLVE_S:
+            break
+        rules = Feasibility(day, times.matrix(), budgets)
+        budget_s = max(remaining * SOLVE_SHARE, MIN_SOLVE_S)
+        outcome = solve_routes(routing_input(rules, minimize_vehicles), budget_s, initial)
+        rounds += 1
+        routes = outcome.routes if outcome is not None else [[] for _ in day.vans]
+        results = {v: day.simulate(v, route) for v, route in enumerate(routes) if route}
+        for v, result in results.items():
+            times.learn(traced_seconds([0, *routes[v], 0], result))
+        failures = {
+            v: failure
+            for v, result in results.items()
+            if (failure := _failure(day, v, result)) is not None
+        }
+        if not failures:
+            break
+        for v, failure in failures.items():
+            if failure.reason == "battery":
+                budgets[v] = _tightened(budgets[v], results[v])
+        rules = Feasibility(day, times.matrix(), budgets)
+        initial = [fitting(rules, v, r) if v in failures else r for v, r in enumerate(routes)]
+    left_out: dict[int, Failure] = {}
+    for v, failure in failures.items():
+        repaired = _repair(day, v, routes[v], failure)
+        routes[v] = repaired.route
+        left_out |= repaired.removed
+        if repaired.result is None:
+            results.pop(v, None)
+        else:
+            results[v] = repaired.result
+    rules = Feasibility(day, times.matrix(), budgets)
+    served = {node for route in routes for node in route}
+    return Routed(
+        routes=[
+            FleetRoute(day.shifts[v].id, results[v]) for v in day.vans if routes[v] and v in results
+        ],
+        unassigned=[
+            explain(rules, node, left_out.get(node), routes)
+            for node in range(1, day.n)
+            if node not in served
+        ],
+        verification_rounds=rounds,
+        objective_value=sum(day.estimates[v].route_cost(r) for v, r in enumerate(routes) if r),
+    )

@@ -1,0 +1,349 @@
+"""The problems and the results of planning, each defined once: the fields every round shares
+(:class:`RoundFields`), one round (:class:`PlanProblem`), a fleet (:class:`FleetProblem`), and
+what comes back — a simulated round (:class:`PlanResult`) and a fleet's day
+(:class:`FleetResult`). The web layer's request models inherit these fields.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from pydantic import Field, ValidationInfo, field_validator
+
+from core.exceptions import InvalidStopsError
+from core.params import (
+    NORMAL_DRIVER,
+    ClockTime,
+    Depot,
+    IsoDate,
+    Objective,
+    Params,
+    RoadMatrix,
+    Stop,
+    StreetTypeName,
+    VanParams,
+    Weather,
+    clock_field,
+)
+from core.physics.battery import BatteryVerdict
+from core.physics.weather import DayWeather, WeatherSource
+from core.routing.geo import DistanceSource
+from core.routing.tsp import SolverStatus
+
+#: Longest round the planner simulates [s] (a week): longer inputs are mistakes.
+MAX_ROUND_S = 7 * 86_400.0
+#: Most vans in one fleet plan.
+MAX_VEHICLES = 100
+#: Solver budget of one round [s] when the request gives none: everyday rounds are proven
+#: optimal well within it.
+PLAN_TIME_LIMIT_S = 1.0
+#: Solver budget of a fleet [s] when the request gives none: the split across vans and the
+#: verification by simulation take longer than one round.
+FLEET_TIME_LIMIT_S = 5.0
+#: Longest solver budget a problem may ask for [s].
+MAX_TIME_LIMIT_S = 600.0
+
+
+def time_limit_field(default_s: float) -> float:
+    """The ``time_limit_s`` field of a problem with its default [s]."""
+    return Field(
+        default_s,
+        gt=0,
+        le=MAX_TIME_LIMIT_S,
+        description="Solver budget [s], capped by the server's setting.",
+    )
+
+
+class RoundFields(Params):
+    """What every round shares: the day, the places and the conditions."""
+
+    date: IsoDate = Field(..., description="Day of the round, YYYY-MM-DD.")
+    timezone: str | None = Field(
+        None,
+        max_length=64,
+        description="IANA time zone (Europe/Vienna); absent: local mean solar time at the depot.",
+    )
+    depot: Depot = Field(..., description="Where the round starts and ends.")
+    stops: list[Stop] = Field(..., min_length=1, description="The stops, in any order.")
+    weather: Weather | None = Field(
+        None, description="The day's forecast; absent: the climatology for date and latitude."
+    )
+    driver_aggressiveness: float = Field(
+        NORMAL_DRIVER, ge=0, le=1, description="ε_d [–]: 0.2 calm, 0.5 normal, 1 aggressive."
+    )
+    traffic_density: float | None = Field(
+        None, gt=0, lt=1, description="ε_t [–]; absent: the street type's default."
+    )
+    objective: Objective = Field("distance", description="What the tour minimises.")
+    matrix: RoadMatrix | None = Field(
+        None, description="Road distances/durations from your router: depot first, then stops."
+    )
+
+    @property
+    def places(self) -> list[Depot]:
+        """The depot, then the stops in request order (index 0 is the depot)."""
+        return [self.depot, *self.stops]
+
+
+def fields_of(source: Params, fields: type[Params]) -> dict[str, Any]:
+    """The values of the fields that ``fields`` declares, from a model that has them too (a
+    round's fields from a fleet, a plan's from a request)."""
+    return {name: getattr(source, name) for name in fields.model_fields}
+
+
+class PlanFields(RoundFields):
+    """One round: when it leaves, and whether its order is the client's."""
+
+    start_time: ClockTime = clock_field(
+        "08:00",
+        "Departure, local HH:MM (with time windows: the earliest; the van leaves later when the "
+        "first stop's window opens later).",
+    )
+    keep_order: bool = Field(False, description="Drive the stops in the given order.")
+    time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT_S)
+
+
+class PlanProblem(PlanFields):
+    """Everything a round needs: its fields and the van."""
+
+    van: VanParams = Field(default_factory=VanParams, description="The van.")
+
+
+def shift_in_order(start: dt.time | None, end: dt.time) -> dt.time:
+    """``end`` when it is after ``start`` (shifts end on the day they start)."""
+    if start is not None and end <= start:
+        raise ValueError("shift_end must be after shift_start (shifts end on the same day)")
+    return end
+
+
+class ShiftFields(Params):
+    """One van of a fleet without its parameters: its id and its driver's shift."""
+
+    id: str = Field(
+        ..., min_length=1, max_length=64, description="Identifier of the van, unique in the fleet."
+    )
+    shift_start: ClockTime = clock_field("08:00", "Earliest departure from the depot, local HH:MM.")
+    shift_end: ClockTime = clock_field(
+        "18:00", "Latest return to the depot, local HH:MM, after shift_start (same day)."
+    )
+
+    @field_validator("shift_end")
+    @classmethod
+    def _after_start(cls, value: dt.time, info: ValidationInfo) -> dt.time:
+        return shift_in_order(info.data.get("shift_start"), value)
+
+
+class FleetVehicle(ShiftFields):
+    """One van of the fleet and its driver's shift."""
+
+    van: VanParams = Field(default_factory=VanParams, description="The van, as in a plan.")
+
+
+class FleetFields(RoundFields):
+    """A fleet's day: how the vans are chosen."""
+
+    minimize_vehicles: bool = Field(
+        True, description="Fewer vans first, then the objective; false: the objective alone."
+    )
+    time_limit_s: float = time_limit_field(FLEET_TIME_LIMIT_S)
+
+
+def vehicles_field() -> list[FleetVehicle]:
+    """The ``vehicles`` field of a fleet."""
+    return Field(
+        ...,
+        min_length=1,
+        max_length=MAX_VEHICLES,
+        description="The vans that may drive, each with its van, battery, payload and shift; "
+        "those listed first drive first when as good.",
+    )
+
+
+class FleetProblem(FleetFields):
+    """The day's stops and the fleet that serves them from one depot."""
+
+    vehicles: list[FleetVehicle] = vehicles_field()
+
+
+def check_stop_ids(depot: Depot, stops: Sequence[Stop]) -> None:
+    """Every stop's id is its own (and not the depot's); else an error naming the second."""
+    seen: dict[str, int] = {depot.id: -1}
+    for index, stop in enumerate(stops):
+        if stop.id in seen:
+            other = "the depot" if seen[stop.id] < 0 else f"stops[{seen[stop.id]}]"
+            raise InvalidStopsError(
+                f"stop id '{stop.id}' is used twice (also by {other}); ids must be unique",
+                f"stops[{index}].id",
+            )
+        seen[stop.id] = index
+
+
+def place_field(index: int) -> str:
+    """The request field of place ``index`` (0 the depot)."""
+    return "depot" if index == 0 else f"stops[{index - 1}]"
+
+
+# --- results ------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class LegResult:
+    """One driven leg of the round.
+
+    ``geometry`` is the road as ``(lon, lat)`` points: the router's polyline, or the straight
+    line between the two places when the distances are an estimate or the client's.
+    """
+
+    from_id: str
+    to_id: str
+    depart: dt.datetime
+    arrive: dt.datetime
+    distance_m: float
+    duration_s: float
+    street_type: StreetTypeName
+    grade: float
+    energy_kwh: dict[str, float]
+    soc_start: float
+    soc_end: float
+    geometry: list[tuple[float, float]]
+
+
+@dataclass(frozen=True)
+class StopResult:
+    """One stop of the round, in visiting order."""
+
+    id: str
+    arrival: dt.datetime
+    service_start: dt.datetime
+    wait_s: float
+    departure: dt.datetime
+    door_heat_kwh: float
+    payload_after_kg: float
+    energy_kwh: dict[str, float]
+    soc_arrival: float
+    soc_departure: float
+    snap_distance_m: float | None
+    lat: float
+    lon: float
+
+
+@dataclass(frozen=True)
+class DayProfile:
+    """Cumulative energy per consumer over the clock time of the round (paper Fig. 8).
+
+    Attributes
+    ----------
+    time
+        Moments every minute from departure to return, local time.
+    energy_kwh
+        Energy used since departure at each moment, per consumer and ``total`` [kWh].
+    """
+
+    time: list[dt.datetime]
+    energy_kwh: dict[str, list[float]]
+
+
+@dataclass(frozen=True)
+class Solved:
+    """How the order of the stops was found: the solver's status, the objective's value in its
+    unit (m, s or Wh) and the search time [s]."""
+
+    status: SolverStatus
+    objective_value: float
+    runtime_s: float
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """The solved and simulated round."""
+
+    tour: list[str]
+    legs: list[LegResult]
+    stops: list[StopResult]
+    distance_m: float
+    duration_s: float
+    energy_kwh: dict[str, float]
+    energy_share: dict[str, float]
+    battery: BatteryVerdict
+    battery_loss_kwh: float
+    grid_kwh: float
+    first_infeasible_leg: int | None
+    max_box_temperature_c: float | None
+    minutes_above_product_limit: float | None
+    weather: Weather
+    weather_days: list[DayWeather]
+    weather_source: WeatherSource
+    warnings: list[str]
+    timezone: str
+    distance_source: DistanceSource
+    depot_snap_distance_m: float | None
+    solved: Solved
+    objective: Objective
+    profile: DayProfile
+    late_stops: list[str]
+
+
+UnassignedReason = Literal["time_window", "capacity", "battery", "shift", "unreachable"]
+
+
+@dataclass(frozen=True)
+class Unassigned:
+    """A stop no van serves, why (``reason``) and a sentence that says so (``detail``)."""
+
+    id: str
+    reason: UnassignedReason
+    detail: str
+
+
+@dataclass(frozen=True)
+class FleetRoute:
+    """The simulated day of one van that drives."""
+
+    vehicle_id: str
+    plan: PlanResult
+
+
+@dataclass(frozen=True)
+class FleetResult:
+    """The fleet's plan for the day.
+
+    Attributes
+    ----------
+    routes
+        One simulated day per van that drives, in the order of the request's vans.
+    unassigned
+        The stops no van serves, each with its reason.
+    distance_m, duration_s
+        Over every route: driven distance [m] and time from each departure to its return [s].
+    energy_kwh
+        Energy per consumer and ``total`` over every route [kWh].
+    grid_kwh
+        Pre-conditioning on grid power at the depot, over every route [kWh].
+    vehicles_used
+        Vans that drive.
+    objective, objective_value
+        What the solver minimised, and its value over the routes (m, s or Wh, estimated).
+    runtime_s, verification_rounds
+        The whole time taken [s], and how often the fleet was verified by simulation (and
+        re-solved after a failed verification).
+    timezone, distance_source, warnings
+        As in a round's result.
+    """
+
+    routes: list[FleetRoute]
+    unassigned: list[Unassigned]
+    distance_m: float
+    duration_s: float
+    energy_kwh: dict[str, float]
+    grid_kwh: float
+    vehicles_used: int
+    objective: Objective
+    objective_value: float
+    runtime_s: float
+    verification_rounds: int
+    timezone: str
+    distance_source: DistanceSource
+    warnings: list[str]

@@ -1,0 +1,267 @@
+"""One van's day sample by sample (paper §4, Fig. 7): from the order of its stops, depart,
+drive each leg (the router's road speed profile, or a generated trace lasting the leg's
+duration), arrive, wait for the stop's time window, park, open the door within the service
+time, unload (the payload and so the mass drop), go on, return.
+
+Time windows are in seconds after the day's departure; :func:`next_window` is the one rule for
+when a van that arrives may start its service.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from core.arrays import FloatArray
+from core.params import STREET_TYPES, Depot, DoorOpening, Interval, Stop, StreetTypeName
+from core.physics.cycles import drive_profile, generate_leg, stretch_to_duration
+from core.planning.model import PlanProblem
+from core.routing.geo import STREET_TYPE_NAMES, Legs, street_type_by_speed
+from core.routing.roads import LegRoute, bearing_deg
+
+#: Sampling interval of the day's simulation [s].
+PLAN_DT_S = 1.0
+#: A place's time windows: ``(opens, closes)`` in seconds after a reference, sorted.
+Windows = Sequence[tuple[float, float]]
+
+
+def next_window(arrival_s: float, windows_s: Windows) -> tuple[float, float] | None:
+    """The window a van arriving at ``arrival_s`` is served in: the first that has not closed
+    (it may open later: the van waits), ``(−inf, inf)`` for a place without windows, None when
+    every window has closed."""
+    if not windows_s:
+        return (-math.inf, math.inf)
+    return next(((a, b) for a, b in windows_s if arrival_s <= b), None)
+
+
+def windows_after(
+    stops: Sequence[Stop], date: dt.date, reference: dt.datetime
+) -> list[list[tuple[float, float]]]:
+    """Each place's time windows (depot first, none) in seconds after ``reference``: the local
+    clock times on ``date`` in ``reference``'s zone, as elapsed time (daylight saving counted)."""
+    zone = reference.tzinfo
+    origin = reference.timestamp()
+
+    def seconds(clock: dt.time) -> float:
+        return dt.datetime.combine(date, clock, tzinfo=zone).timestamp() - origin
+
+    return [[]] + [
+        [(seconds(w.start), seconds(w.end)) for w in stop.time_windows] for stop in stops
+    ]
+
+
+def drive(
+    problem: PlanProblem,
+    legs: Legs,
+    i: int,
+    j: int,
+    route: LegRoute | None,
+    straight_heading_deg: float = 0.0,
+) -> tuple[FloatArray, FloatArray, StreetTypeName]:
+    """Speed trace [m/s, every :data:`PLAN_DT_S`], heading of each sample [°] and street type
+    of the leg from place i to place j: the road's speed profile from a router, or the paper's
+    trace for the leg's street type (stretched to the client's duration for a client matrix)."""
+    vehicle = problem.van.vehicle
+    if route is None:
+        street_type = legs.street_type_name(i, j)
+        trace = generate_leg(
+            float(legs.distance_m[i, j]),
+            STREET_TYPES[street_type],
+            problem.driver_aggressiveness,
+            vehicle.max_acceleration_mps2,
+            problem.traffic_density,
+            PLAN_DT_S,
+        )
+        if legs.source == "client":  # the client's router knows how long the leg takes
+            trace = stretch_to_duration(trace, PLAN_DT_S, float(legs.duration_s[i, j]))
+        return trace, np.full(trace.size, straight_heading_deg), street_type
+    free_flow_s = float(np.sum(route.segment_distance_m / route.segment_speed_mps))
+    street_type = STREET_TYPE_NAMES[int(street_type_by_speed(route.distance_m, free_flow_s))]
+    trace, travelled = drive_profile(
+        route.segment_distance_m,
+        route.segment_speed_mps,
+        STREET_TYPES[street_type],
+        problem.driver_aggressiveness,
+        vehicle.max_acceleration_mps2,
+        problem.traffic_density,
+        PLAN_DT_S,
+    )
+    ends = np.cumsum(route.segment_distance_m)
+    segment = np.minimum(np.searchsorted(ends, travelled), ends.size - 1)
+    return trace, route.segment_heading_deg[segment], street_type
+
+
+def drive_time_s(problem: PlanProblem, legs: Legs, i: int, j: int, route: LegRoute | None) -> float:
+    """How long the van takes from place i to place j in the simulation [s] (the generated or
+    road-profile trace, which may differ from the matrix's duration)."""
+    trace, _, _ = drive(problem, legs, i, j, route)
+    return (trace.size - 1) * PLAN_DT_S
+
+
+@dataclass(frozen=True)
+class Timeline:
+    """The day sample by sample, and the marks that split it: leg k drives from depart[k] to
+    arrive[k]; the stop after it (if any) waits for its window until serve[k] and lasts until
+    leave[k]; ``late`` lists the places reached after their last window closed."""
+
+    speed: FloatArray
+    grade: FloatArray
+    payload: FloatArray
+    heading: FloatArray
+    doors: list[DoorOpening]
+    parked: list[Interval]
+    depart: NDArray[np.int_]
+    arrive: NDArray[np.int_]
+    serve: NDArray[np.int_]
+    leave: NDArray[np.int_]
+    late: list[int]
+    street_types: list[StreetTypeName]
+    geometry: list[list[tuple[float, float]]]
+
+    @property
+    def duration_s(self) -> float:
+        """From departure to return [s]."""
+        return (self.speed.size - 1) * PLAN_DT_S
+
+
+@dataclass
+class _Builder:
+    """The day's samples as they are appended, part by part."""
+
+    payload_kg: float
+    clock: int = 0
+    speed: list[FloatArray] = field(default_factory=lambda: [np.zeros(1)])
+    grade: list[FloatArray] = field(default_factory=lambda: [np.zeros(1)])
+    heading: list[FloatArray] = field(default_factory=lambda: [np.full(1, np.nan)])
+    payload: list[FloatArray] = field(default_factory=list)
+    doors: list[DoorOpening] = field(default_factory=list)
+    parked: list[Interval] = field(default_factory=list)
+    marks: dict[str, list[int]] = field(
+        default_factory=lambda: {"depart": [], "arrive": [], "serve": [], "leave": []}
+    )
+    late: list[int] = field(default_factory=list)
+    street_types: list[StreetTypeName] = field(default_factory=list)
+    geometry: list[list[tuple[float, float]]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.payload.append(np.array([self.payload_kg]))
+
+    def drive(self, trace: FloatArray, heading: FloatArray, grade: float) -> None:
+        """Append a leg's samples after its first (the van stands there already)."""
+        samples = trace[1:]
+        self.marks["depart"].append(self.clock)
+        self.clock += samples.size
+        self.marks["arrive"].append(self.clock)
+        self.speed.append(samples)
+        self.heading.append(heading[1:])
+        self.grade.append(np.full(samples.size, grade))
+        self.payload.append(np.full(samples.size, self.payload_kg))
+
+    def stand(self, samples: int, payload_kg: float) -> None:
+        """Append ``samples`` parked samples at ``payload_kg``."""
+        self.speed.append(np.zeros(samples))
+        self.grade.append(np.zeros(samples))
+        self.heading.append(np.full(samples, np.nan))
+        self.payload.append(np.full(samples, payload_kg))
+        self.clock += samples
+
+    def serve(self, place: int, stop: Stop, windows_s: Windows) -> None:
+        """Wait for the stop's window, then serve it with the door open; the van leaves
+        lighter by what it unloaded."""
+        arrival_s = self.clock * PLAN_DT_S
+        window = next_window(arrival_s, windows_s)
+        if window is None:
+            self.late.append(place)
+        wait = math.ceil(max((window or (0.0, 0.0))[0] - arrival_s, 0.0) / PLAN_DT_S)
+        dwell = math.ceil(stop.service_time_s / PLAN_DT_S)
+        self.parked.append(Interval(start_s=arrival_s, duration_s=(wait + dwell) * PLAN_DT_S))
+        self.stand(wait, self.payload_kg)
+        self.marks["serve"].append(self.clock)
+        if stop.door_open_s > 0:
+            self.doors.append(
+                DoorOpening(start_s=self.clock * PLAN_DT_S, duration_s=stop.door_open_s)
+            )
+        # Unloading happens during the service: the lighter van drives away.
+        self.payload_kg = max(self.payload_kg - stop.delivery_kg, 0.0)
+        self.stand(dwell, self.payload_kg)
+
+    def finish(self) -> Timeline:
+        marks = {name: np.array(values) for name, values in self.marks.items()}
+        return Timeline(
+            speed=np.concatenate(self.speed),
+            grade=np.concatenate(self.grade),
+            payload=np.concatenate(self.payload),
+            heading=np.concatenate(self.heading),
+            doors=self.doors,
+            parked=self.parked,
+            depart=marks["depart"],
+            arrive=marks["arrive"],
+            serve=marks["serve"],
+            leave=marks["leave"],
+            late=self.late,
+            street_types=self.street_types,
+            geometry=self.geometry,
+        )
+
+
+def build_timeline(
+    problem: PlanProblem,
+    places: list[Depot],
+    legs: Legs,
+    order: list[int],
+    routes: list[LegRoute] | None,
+    windows_s: Sequence[Windows] | None = None,
+) -> Timeline:
+    """Speed, grade, payload and heading of every sample of the day, the door openings, the
+    stops and the marks, for the places in ``order`` (depot first and last). With
+    ``windows_s`` (each place's time windows, seconds after the departure) the van waits,
+    parked with the door shut, for a stop's window to open; a stop reached after its last
+    window closes is served at once and listed in ``late``."""
+    day = _Builder(problem.van.payload_kg)
+    for k, (i, j) in enumerate(itertools.pairwise(order)):
+        a, b = places[i], places[j]
+        route = routes[k] if routes is not None else None
+        trace, heading, street_type = drive(
+            problem, legs, i, j, route, bearing_deg(a.lat, a.lon, b.lat, b.lon)
+        )
+        day.street_types.append(street_type)
+        day.geometry.append(
+            [(float(x), float(y)) for x, y in route.coordinates]
+            if route is not None
+            else [(a.lon, a.lat), (b.lon, b.lat)]
+        )
+        day.drive(trace, heading, float(legs.grade[i, j]))
+        if j != 0:
+            day.serve(j, problem.stops[j - 1], windows_s[j] if windows_s is not None else ())
+        else:
+            day.marks["serve"].append(day.clock)
+        day.marks["leave"].append(day.clock)
+    return day.finish()
+
+
+def later_departure_s(
+    timeline: Timeline,
+    order: list[int],
+    windows_s: Sequence[Windows],
+    latest_return_s: float | None,
+) -> float:
+    """How much later the van can leave and wait less [s]: a delay is absorbed by the waits
+    before each stop, and beyond them shifts the stop's service, which must stay inside its
+    window (the forward time slack of Savelsbergh, *ORSA J. Computing* 4 (1992) 146)."""
+    waited = 0.0
+    slack = (
+        math.inf if latest_return_s is None else latest_return_s - timeline.leave[-1] * PLAN_DT_S
+    )
+    for k, j in enumerate(order[1:-1]):
+        served_s = timeline.serve[k] * PLAN_DT_S
+        waited += served_s - timeline.arrive[k] * PLAN_DT_S
+        window = next_window(served_s, windows_s[j])
+        closes = math.inf if window is None else window[1]
+        slack = min(slack, waited + closes - served_s)
+    return float(max(min(waited, slack), 0.0) // PLAN_DT_S * PLAN_DT_S)

@@ -1,0 +1,280 @@
+"""A route verified by the full simulation of its day: the timeline (:mod:`core.planning.timeline`)
+simulated in one vectorised pass (:func:`core.physics.simulate.simulate`), split per leg and per
+stop into a :class:`core.planning.model.PlanResult`, and the rules it breaks, if any
+(:func:`route_failure`): a window missed, back after the shift, the charge below the reserve.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.clock import at, check_representable
+from core.params import Depot, Location
+from core.physics.battery import JOULES_PER_KWH
+from core.physics.cycles import trace_distance_m
+from core.physics.simulate import CONSUMERS, SimulationResult, simulate
+from core.planning.model import (
+    DayProfile,
+    LegResult,
+    PlanProblem,
+    PlanResult,
+    Solved,
+    StopResult,
+    UnassignedReason,
+)
+from core.planning.scene import Scene
+from core.planning.timeline import (
+    PLAN_DT_S,
+    Timeline,
+    Windows,
+    build_timeline,
+    later_departure_s,
+)
+from core.routing.roads import LegRoute
+
+#: Spacing of the day profile's points [s].
+PROFILE_STEP_S = 60.0
+
+
+def simulate_route(
+    problem: PlanProblem,
+    scene: Scene,
+    order: list[int],
+    start: dt.datetime,
+    roads: list[LegRoute] | None,
+    solved: Solved,
+    windows_s: Sequence[Windows] | None = None,
+    latest_return_s: float | None = None,
+) -> PlanResult:
+    """Drive the places in ``order`` (depot first and last) from ``start`` and simulate the day.
+
+    Parameters
+    ----------
+    problem
+        The van, the stops and the conditions.
+    scene
+        The places, their legs, the zone and the weather.
+    order
+        Place indices in driving order, 0 first and last.
+    start
+        Departure (zone-aware).
+    roads
+        The road of each leg of ``order`` from a router, or None to generate the traces.
+    solved
+        How the order was found (reported as it is).
+    windows_s
+        Each place's time windows [s after ``start``]. The van waits at a stop for its window,
+        and leaves the depot as much later as saves waiting without missing a window or
+        ``latest_return_s``. Stops reached after their last window closes are served at once
+        and listed in ``late_stops``.
+    latest_return_s
+        When the van must be back [s after ``start``], if ever.
+    """
+    timeline = build_timeline(problem, scene.places, scene.legs, order, roads, windows_s)
+    if windows_s is not None:
+        delay_s = later_departure_s(timeline, order, windows_s, latest_return_s)
+        if delay_s > 0:
+            start = at(start, delay_s)
+            windows_s = [[(a - delay_s, b - delay_s) for a, b in place] for place in windows_s]
+            timeline = build_timeline(problem, scene.places, scene.legs, order, roads, windows_s)
+    check_representable(start, timeline.duration_s, "date")
+    weather, warnings = scene.weather_for(start, timeline.duration_s)
+    result = simulate(
+        timeline.speed,
+        PLAN_DT_S,
+        start,
+        Location(lat=problem.depot.lat, lon=problem.depot.lon),
+        problem.van,
+        grade=timeline.grade,
+        payload_kg=timeline.payload,
+        weather=weather,
+        door_openings=timeline.doors,
+        parked=timeline.parked,
+        heading_deg=timeline.heading,
+    )
+    return _Split(problem, scene, order, result, timeline, start).result(solved, warnings)
+
+
+class _Split:
+    """One simulated day split per leg, per stop and per minute."""
+
+    def __init__(
+        self,
+        problem: PlanProblem,
+        scene: Scene,
+        order: list[int],
+        result: SimulationResult,
+        timeline: Timeline,
+        start: dt.datetime,
+    ) -> None:
+        self.problem, self.scene, self.order = problem, scene, order
+        self.simulated, self.timeline, self.start = result, timeline, start
+        self.cumulative_j = {
+            name: np.concatenate(([0.0], np.cumsum(power) * PLAN_DT_S))
+            for name, power in result.power_w.items()
+        }
+        self.door_j = np.concatenate(([0.0], np.cumsum(result.box.door_heat_w) * PLAN_DT_S))
+
+    def moment(self, sample: int) -> dt.datetime:
+        return at(self.start, float(sample) * PLAN_DT_S)
+
+    def span_kwh(self, a: int, b: int) -> dict[str, float]:
+        """Energy per consumer and total between samples a and b [kWh]."""
+        energy = {
+            name: float(c[b] - c[a]) / JOULES_PER_KWH for name, c in self.cumulative_j.items()
+        }
+        energy["total"] = sum(energy.values())
+        return energy
+
+    def legs(self) -> list[LegResult]:
+        places, legs, soc = self.scene.places, self.scene.legs, self.simulated.soc
+        out = []
+        for k, (i, j) in enumerate(itertools.pairwise(self.order)):
+            a, b = int(self.timeline.depart[k]), int(self.timeline.arrive[k])
+            out.append(
+                LegResult(
+                    from_id=places[i].id,
+                    to_id=places[j].id,
+                    depart=self.moment(a),
+                    arrive=self.moment(b),
+                    distance_m=trace_distance_m(self.simulated.speed_mps[a : b + 1], PLAN_DT_S),
+                    duration_s=(b - a) * PLAN_DT_S,
+                    street_type=self.timeline.street_types[k],
+                    grade=float(legs.grade[i, j]),
+                    energy_kwh=self.span_kwh(a, b),
+                    soc_start=float(soc[a]),
+                    soc_end=float(soc[b]),
+                    geometry=self.timeline.geometry[k],
+                )
+            )
+        return out
+
+    def stops(self) -> list[StopResult]:
+        places, soc, snap = self.scene.places, self.simulated.soc, self.scene.legs.snap_distance_m
+        out = []
+        payload = self.problem.van.payload_kg
+        for k, j in enumerate(self.order[1:-1]):
+            b, c = int(self.timeline.arrive[k]), int(self.timeline.leave[k])
+            served = int(self.timeline.serve[k])
+            payload = max(payload - self.problem.stops[j - 1].delivery_kg, 0.0)
+            out.append(
+                StopResult(
+                    id=places[j].id,
+                    arrival=self.moment(b),
+                    service_start=self.moment(served),
+                    wait_s=(served - b) * PLAN_DT_S,
+                    departure=self.moment(c),
+                    door_heat_kwh=float(self.door_j[c] - self.door_j[b]) / JOULES_PER_KWH,
+                    payload_after_kg=payload,
+                    energy_kwh=self.span_kwh(b, c),
+                    soc_arrival=float(soc[b]),
+                    soc_departure=float(soc[c]),
+                    snap_distance_m=None if snap is None else float(snap[j]),
+                    lat=places[j].lat,
+                    lon=places[j].lon,
+                )
+            )
+        return out
+
+    def profile(self) -> DayProfile:
+        size = self.simulated.time_s.size
+        every = max(round(PROFILE_STEP_S / PLAN_DT_S), 1)
+        picks = np.unique(np.append(np.arange(0, size, every), size - 1))
+        kwh = {name: (c[picks] / JOULES_PER_KWH).tolist() for name, c in self.cumulative_j.items()}
+        kwh["total"] = np.sum([kwh[name] for name in CONSUMERS], axis=0).tolist()
+        return DayProfile([self.moment(int(i)) for i in picks], kwh)
+
+    def result(self, solved: Solved, warnings: list[str]) -> PlanResult:
+        simulated, places, legs = self.simulated, self.scene.places, self.scene.legs
+        total = simulated.energy_kwh["total"]
+        first_bad = simulated.battery.first_infeasible_index
+        dynamic = self.problem.van.cargo_box.mode == "dynamic"
+        snap = legs.snap_distance_m
+        return PlanResult(
+            tour=[places[i].id for i in self.order],
+            legs=self.legs(),
+            stops=self.stops(),
+            distance_m=simulated.distance_m,
+            duration_s=simulated.duration_s,
+            energy_kwh=dict(simulated.energy_kwh),
+            energy_share={
+                name: (simulated.energy_kwh[name] / total if total > 0 else 0.0)
+                for name in CONSUMERS
+            },
+            battery=simulated.battery,
+            battery_loss_kwh=simulated.battery_loss_kwh,
+            grid_kwh=simulated.grid_kwh,
+            first_infeasible_leg=(
+                None
+                if first_bad is None
+                else int(np.searchsorted(self.timeline.leave, first_bad, side="left"))
+            ),
+            max_box_temperature_c=simulated.box.max_temperature_c if dynamic else None,
+            minutes_above_product_limit=simulated.box.minutes_above_limit if dynamic else None,
+            weather=simulated.weather,
+            weather_days=simulated.weather_days,
+            weather_source=simulated.weather_source,
+            warnings=warnings,
+            timezone=self.scene.timezone_name,
+            distance_source=legs.source,
+            depot_snap_distance_m=None if snap is None else float(snap[0]),
+            solved=solved,
+            objective=self.problem.objective,
+            profile=self.profile(),
+            late_stops=[places[j].id for j in self.timeline.late],
+        )
+
+
+@dataclass(frozen=True)
+class Failure:
+    """Why a simulated route does not hold: the rule and, for the stop-bound rules, the stop
+    (its place index)."""
+
+    reason: UnassignedReason
+    node: int | None
+    detail: str
+
+
+def route_failure(
+    van_id: str,
+    problem: PlanProblem,
+    places: list[Depot],
+    result: PlanResult,
+    shift_end: dt.datetime | None,
+    battery_enforced: bool,
+) -> Failure | None:
+    """The first rule the simulated route of van ``van_id`` breaks, if any: a stop reached
+    after its last window closes, back after ``shift_end``, and — when the battery is a
+    constraint (``battery_enforced``) — its charge below the reserve."""
+    if result.late_stops:
+        node = next(k for k, place in enumerate(places) if place.id == result.late_stops[0])
+        return Failure("time_window", node, f"{van_id} would reach it after its last window closes")
+    back = result.legs[-1].arrive
+    if shift_end is not None and back > shift_end:
+        return Failure(
+            "shift",
+            None,
+            f"{van_id} would be back at {back:%H:%M}, after its shift ends at {shift_end:%H:%M}",
+        )
+    if battery_enforced and not result.battery.feasible:
+        return Failure(
+            "battery",
+            None,
+            f"the simulated day of {van_id} would take its battery to "
+            f"{result.battery.min_soc:.0%}, below its reserve of "
+            f"{problem.van.battery.min_soc:.0%}",
+        )
+    return None
+
+
+def traced_seconds(order: list[int], result: PlanResult) -> list[tuple[tuple[int, int], float]]:
+    """Each arc of ``order`` and how long the simulation drove it [s]."""
+    return [
+        ((i, j), leg.duration_s)
+        for (i, j), leg in zip(itertools.pairwise(order), result.legs, strict=True)
+    ]
