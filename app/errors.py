@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Awaitable, Callable, Mapping
+from typing import Any, TypeVar
 
-from fastapi import FastAPI, Request
+from fastapi import FastAPI, Request, Response
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from sqlalchemy.exc import OperationalError
@@ -16,6 +16,7 @@ from app.execution import UnavailableError
 from core.exceptions import CoreError, LimitExceededError, ServiceUnavailableError
 
 PROBLEM_JSON = "application/problem+json"
+E = TypeVar("E", bound=Exception)
 _log = logging.getLogger("coldroute")
 
 
@@ -76,8 +77,20 @@ def _message(error: Any) -> str:
     return str(error["msg"])
 
 
-async def _validation(_: Request, error: Exception) -> JSONResponse:
-    assert isinstance(error, RequestValidationError)
+def _handler(
+    kind: type[E], answer: Callable[[Request, E], Response]
+) -> Callable[[Request, Exception], Awaitable[Response]]:
+    """An exception handler for ``kind`` (Starlette hands every handler a plain exception)."""
+
+    async def handle(request: Request, error: Exception) -> Response:
+        if not isinstance(error, kind):  # registered for another class: not ours to answer
+            raise error
+        return answer(request, error)
+
+    return handle
+
+
+def _validation(_: Request, error: RequestValidationError) -> JSONResponse:
     errors = [
         {
             "field": _location(tuple(e["loc"]), e["type"]),
@@ -90,13 +103,11 @@ async def _validation(_: Request, error: Exception) -> JSONResponse:
     return problem(422, "Invalid request", detail, errors=errors)
 
 
-async def _core(_: Request, error: Exception) -> JSONResponse:
-    assert isinstance(error, CoreError)
+def _core(_: Request, error: CoreError) -> JSONResponse:
     return JSONResponse(core_problem(error), status_code=422, media_type=PROBLEM_JSON)
 
 
-async def _http(request: Request, error: Exception) -> JSONResponse:
-    assert isinstance(error, StarletteHTTPException)
+def _http(request: Request, error: StarletteHTTPException) -> JSONResponse:
     if error.status_code == 405:
         headers = dict(error.headers or {}) | {
             # Every method documented at this path (Starlette names only the first route's).
@@ -121,8 +132,7 @@ async def _http(request: Request, error: Exception) -> JSONResponse:
 SERVICE_RETRY_AFTER_S = 30
 
 
-async def _service(_: Request, error: Exception) -> JSONResponse:
-    assert isinstance(error, ServiceUnavailableError)
+def _service(_: Request, error: ServiceUnavailableError) -> JSONResponse:
     return JSONResponse(
         service_problem(error),
         status_code=503,
@@ -131,8 +141,7 @@ async def _service(_: Request, error: Exception) -> JSONResponse:
     )
 
 
-async def _unavailable(_: Request, error: Exception) -> JSONResponse:
-    assert isinstance(error, UnavailableError)
+def _unavailable(_: Request, error: UnavailableError) -> JSONResponse:
     return problem(
         503,
         "Service unavailable",
@@ -142,7 +151,7 @@ async def _unavailable(_: Request, error: Exception) -> JSONResponse:
     )
 
 
-async def _database(_: Request, error: Exception) -> JSONResponse:
+def _database(_: Request, error: OperationalError) -> JSONResponse:
     _log.warning("database unavailable: %s", error)
     return problem(
         503,
@@ -155,10 +164,10 @@ async def _database(_: Request, error: Exception) -> JSONResponse:
 
 def install(app: FastAPI) -> None:
     """Register the problem handlers on ``app``."""
-    app.add_exception_handler(RequestValidationError, _validation)
-    app.add_exception_handler(CoreError, _core)
-    app.add_exception_handler(ServiceUnavailableError, _service)
-    app.add_exception_handler(UnavailableError, _unavailable)
-    app.add_exception_handler(StarletteHTTPException, _http)
-    app.add_exception_handler(OperationalError, _database)
+    app.add_exception_handler(RequestValidationError, _handler(RequestValidationError, _validation))
+    app.add_exception_handler(CoreError, _handler(CoreError, _core))
+    app.add_exception_handler(ServiceUnavailableError, _handler(ServiceUnavailableError, _service))
+    app.add_exception_handler(UnavailableError, _handler(UnavailableError, _unavailable))
+    app.add_exception_handler(StarletteHTTPException, _handler(StarletteHTTPException, _http))
+    app.add_exception_handler(OperationalError, _handler(OperationalError, _database))
     # Anything else: app.main.RequestContext answers 500 and logs it once.

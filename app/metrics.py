@@ -10,6 +10,8 @@ from prometheus_client import CollectorRegistry, Counter, Gauge, Histogram
 from prometheus_client.core import GaugeMetricFamily
 from prometheus_client.registry import Collector
 
+from app.jobs.models import STATUSES
+
 #: Latency buckets [s]: from a cached answer to a 10 s solve.
 LATENCY_BUCKETS_S = (0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10, 30, 60)
 
@@ -26,7 +28,7 @@ class _JobsByStatus(Collector):
             counts = self.counts()
         except Exception:  # a database that is away shows in /readyz, not as a scrape error
             counts = {}
-        for status in ("queued", "running", "succeeded", "failed", "cancelled"):
+        for status in STATUSES:
             family.add_metric([status], counts.get(status, 0))
         yield family
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from functools import lru_cache
+from typing import Annotated
 
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
@@ -127,6 +128,13 @@ class Settings(BaseSettings):
     )
     job_max_attempts: int = Field(
         3, ge=1, le=20, description="Runs of a job before it is failed (worker lost, router down)."
+    )
+    job_retry_backoff_s: list[Annotated[float, Field(ge=0, le=3600)]] = Field(
+        default_factory=lambda: [5.0, 20.0, 60.0],
+        min_length=1,
+        max_length=20,
+        description="Wait before the 2nd, 3rd, … run of a job whose outside service failed [s], "
+        "JSON list; the last value repeats.",
     )
 
     @property

@@ -36,22 +36,31 @@ class CeleryDispatcher:
             with contextlib.suppress(asyncio.CancelledError):
                 await self._task
 
+    @property
+    def resend_after_s(self) -> float:
+        """How long a sent job may wait to start before its message counts as lost [s]."""
+        return max(10 * self.settings.job_stale_after_s, 120.0)
+
     def submitted(self, job: JobView) -> None:
         """A job was queued: send it now."""
-        self.dispatch(job)
+        self.dispatch(job.id)
 
-    def dispatch(self, job: JobView) -> None:
-        """Send one job to the workers (a repeated send is harmless: a job runs once)."""
-        self.celery.send_task(TASK, args=[job.id], task_id=f"{job.id}.{uuid.uuid4().hex[:8]}")
-        self.store.mark_dispatched(job.id)
+    def dispatch(self, job_id: str) -> None:
+        """Send one attempt of a job to the workers, unless another dispatcher just did."""
+        if not self.store.take_dispatch(job_id, self.resend_after_s):
+            return
+        try:
+            self.celery.send_task(TASK, args=[job_id], task_id=f"{job_id}.{uuid.uuid4().hex[:8]}")
+        except Exception:
+            self.store.undo_dispatch(job_id)
+            raise
 
     def _sweep(self) -> None:
         self.lifecycle.sweep()
         # Jobs the broker never got (a crash between storing and sending), retries now due,
         # and messages lost (Redis restarted) once they have waited well past a normal start.
-        resend_after_s = max(10 * self.settings.job_stale_after_s, 120.0)
-        for job in self.store.undispatched(older_than_s=resend_after_s):
-            self.dispatch(job)
+        for job in self.store.undispatched(older_than_s=self.resend_after_s):
+            self.dispatch(job.id)
 
     async def _loop(self) -> None:
         while True:

@@ -61,7 +61,7 @@ class RetryPolicy:
     """
 
     max_attempts: int
-    backoff_s: tuple[float, ...] = (5.0, 20.0, 60.0)
+    backoff_s: tuple[float, ...]
 
     def retry_after_s(self, attempts: int) -> float | None:
         """The wait before the next run after ``attempts`` runs [s], or None: no more runs."""
@@ -92,7 +92,7 @@ class Lifecycle:
         self.store = store
         self.settings = settings
         self.runner = runner
-        self.policy = RetryPolicy(settings.job_max_attempts)
+        self.policy = RetryPolicy(settings.job_max_attempts, tuple(settings.job_retry_backoff_s))
 
     def claim_next(self) -> JobView | None:
         """The oldest due job, now running here."""

@@ -328,9 +328,33 @@ class JobStore:
             )
             return [JobView.of(job) for job in session.scalars(query)]
 
-    def mark_dispatched(self, job_id: str) -> None:
+    def take_dispatch(self, job_id: str, resend_after_s: float) -> bool:
+        """Whether this caller is to send the job to the broker now: it is queued and due, and
+        was not sent (or was sent longer ago than ``resend_after_s``, a lost message). One
+        conditional ``UPDATE``, so two dispatchers never both send one attempt."""
+        moment = now()
+        before = moment - dt.timedelta(seconds=resend_after_s)
         with self._transaction() as session:
-            session.execute(update(Job).where(Job.id == job_id).values(dispatched_at=now()))
+            taken = session.execute(
+                update(Job)
+                .where(
+                    Job.id == job_id,
+                    Job.status == "queued",
+                    _due(moment),
+                    Job.dispatched_at.is_(None) | (Job.dispatched_at < before),
+                )
+                .values(dispatched_at=moment)
+            )
+            return bool(taken.rowcount == 1)  # type: ignore[attr-defined]
+
+    def undo_dispatch(self, job_id: str) -> None:
+        """The send failed: the job waits for the next dispatch."""
+        with self._transaction() as session:
+            session.execute(
+                update(Job)
+                .where(Job.id == job_id, Job.status == "queued")
+                .values(dispatched_at=None)
+            )
 
     def fail_exhausted(self, job_id: str, max_attempts: int, error: dict[str, Any]) -> bool:
         """Fail a queued or running job that has used its attempts."""

@@ -354,3 +354,10 @@ class Problem(ApiModel):
     status: int = Field(..., description="The HTTP status code.")
     detail: str = Field(..., description="What went wrong, for a person.")
     errors: list[FieldError] | None = Field(None, description="For invalid requests.")
+    service: str | None = Field(
+        None,
+        description="For a 503: the service that is down (workers, database, osrm, weather).",
+    )
+    request_id: str | None = Field(
+        None, description="For a 500: the request id the error was logged with."
+    )

@@ -65,7 +65,7 @@ class StreetType(Params):
 
 #: Street-type presets. Mean speeds are typical free-flow averages (urban with lights,
 #: rural highway, motorway); the shape parameters are tuned so that a calm and an aggressive
-#: driver differ by the paper's 10–12 % on an urban leg (tests/core/test_cycles.py).
+#: driver differ by the paper's 10–12 % on an urban leg (tests/core/physics/test_cycles.py).
 STREET_TYPES: dict[str, StreetType] = {
     "urban": StreetType(
         mean_speed_mps=30 / 3.6, speed_variation=0.8, period_divisor=16, traffic_density=0.5

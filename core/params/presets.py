@@ -28,7 +28,7 @@ PRESETS: dict[str, Preset] = {
     "reference-zoe": Preset(
         name="reference-zoe",
         description="NREL FASTSim's 2022 Renault Zoe ZE50 R135 as a longitudinal model (the "
-        "validation vehicle of shared/reference/cycles/REFERENCE.md): 1600 kg, c_d 0.33, "
+        "validation vehicle of docs/validation.md): 1600 kg, c_d 0.33, "
         "A_f 2.5122 m², c_r 0.009 with no 1.25 factor, regeneration 0.773, 52 kWh.",
         vehicle=VehicleParams(
             mass_kg=1600.0,
@@ -54,8 +54,8 @@ PRESETS: dict[str, Preset] = {
         "2,450 kg), 500 kg payload; a 9.5 m³ ATP 'IR' box (K = 0.35 W/(m²·K) ≤ 0.4) with an "
         "inverter-driven electric unit (2.5 kW cooling, 1.5 kW heating, 150 W standby, COP a "
         "Carnot fraction), strip curtain; cab HVAC off at stops; battery derated in the cold; "
-        "pre-conditioned at the depot. Validated in tests/core/test_presets.py: WLTC 3b at the "
-        "plug 215–250 Wh/km, refrigeration 1–3 kW at 30 °C / 4 °C, 10 min of open door ≈ 2 h "
+        "pre-conditioned at the depot. Validated (docs/validation.md): WLTC 3b at the plug "
+        "215–250 Wh/km, refrigeration 1–3 kW at 30 °C / 4 °C, 10 min of open door ≈ 2 h "
         "of wall gain.",
         vehicle=VehicleParams(
             mass_kg=2900.0,

@@ -46,34 +46,15 @@ def parked_share(vehicle: VehicleParams) -> float:
     return _PARKED_SHARE.get(vehicle.cab_hvac_at_stops, vehicle.cab_reduced_share)
 
 
-def cab_deficit_j(
-    vehicle: VehicleParams, ambient_c: ArrayLike, parked_s: ArrayLike, initial_j: ArrayLike = 0.0
-) -> FloatArray:
-    """Electric energy to bring the cab back to 20 °C after parking [J].
+def _drift(vehicle: VehicleParams, ambient_c: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Deficit a parked cab settles at [J] and its rate of approach [1/s].
 
     A lumped cab loses heat to the outside with the conductance the Table 2 power implies,
-    ``G = P(ϑ_amb)/|20 °C − ϑ_amb|``, and has the recovery energy ``C`` per kelvin. Parked for
-    ``t`` with the HVAC at share ``s`` of ``P``, its deficit ``d`` [K] relaxes towards
-    ``(1 − s)·|20 − ϑ_amb|`` with the time constant ``C/G`` (first-order response), from
-    ``initial_j/C``; bringing it back costs ``C·d``.
-
-    Parameters
-    ----------
-    ambient_c
-        Outside temperature while parked [°C].
-    parked_s
-        How long the van stands [s]; ``inf`` for a cab that starts at the outside temperature.
-    initial_j
-        Deficit already there when the van parks [J] (a recovery not finished yet).
+    ``G = P(ϑ_amb)/|20 °C − ϑ_amb|``, and has the recovery energy ``C`` per kelvin. Parked with
+    the HVAC at share ``s`` of ``P``, its deficit [K] relaxes towards ``(1 − s)·|20 − ϑ_amb|``
+    with the time constant ``C/G`` (first-order response); bringing it back costs ``C`` per
+    kelvin.
     """
-    settled_j, rate = _drift(vehicle, np.asarray(ambient_c, dtype=float))
-    keep = np.exp(-rate * np.asarray(parked_s, dtype=float))
-    return settled_j + (np.asarray(initial_j, dtype=float) - settled_j) * keep
-
-
-def _drift(vehicle: VehicleParams, ambient_c: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Deficit a parked cab settles at [J] and its rate of approach [1/s]
-    (:func:`cab_deficit_j`)."""
     gap_k = np.abs(CAB_SETPOINT_C - ambient_c)
     power = cabin_hvac_power_w(vehicle, ambient_c)
     capacity = vehicle.cab_recovery_energy_j_k
@@ -93,7 +74,7 @@ def cab_power_w(
     """Electric power of the cab HVAC over each step [W] (Table 2 and the thermal duty).
 
     While driving the HVAC holds 20 °C at the Table 2 power. While parked it draws the parked
-    share of it (``cab_hvac_at_stops``) and the cab drifts (:func:`cab_deficit_j`); once the van
+    share of it (``cab_hvac_at_stops``) and the cab drifts (:func:`_drift`); once the van
     drives on, the HVAC recovers the deficit with the power it has left below
     ``cab_hvac_max_power_w``, as it does at departure for a cab that was not pre-conditioned
     (``initial_deficit_j``). A recovery cut short by the next stop carries its rest into that

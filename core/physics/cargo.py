@@ -212,48 +212,57 @@ def refrigeration(
     the set-point. The state is the temperature, so unloading cargo changes only the heat
     capacity, never the temperature.
     """
-    setpoint = box.setpoint_c
     door_conductance = np.zeros_like(ambient_c)
     is_open = door_open > 0
     door_conductance[is_open] = door_open[is_open] * door_conductance_w_k(box, ambient_c[is_open])
     if box.mode == "steady":
-        temperature = np.full_like(ambient_c, setpoint)
-        wall = wall_heat_w(box, ambient_c, setpoint)
-        door = door_conductance * (ambient_c - setpoint)
-        load = wall + solar_heat + door
-        if initial_c is not None:
-            pulldown_j = box.structure_heat_capacity_j_k * (initial_c - setpoint)
-            rate_w = box.refrigeration_capacity_w if pulldown_j > 0 else box.heating_capacity_w
-            load = load + _front_loaded(pulldown_j, rate_w, load.size, dt_s)
-        cooling = np.maximum(load, 0.0)
-        heating = np.maximum(-load, 0.0) if box.heater_enabled else 0.0
-        cop = refrigeration_cop(box, ambient_c, setpoint)
+        temperature, cooling, heating = _steady(
+            box, ambient_c, solar_heat, door_conductance, dt_s, initial_c
+        )
+        cop = refrigeration_cop(box, ambient_c, box.setpoint_c)
     else:
         capacity = heat_capacity_j_k(box, np.broadcast_to(payload_kg, ambient_c.shape))
-        if initial_c is None:
-            start_c = setpoint
-        else:
-            warm = capacity[0] - np.asarray(payload_kg, dtype=float).flat[0] * (
-                box.cargo_specific_heat_j_kgk
-            )
-            start_c = setpoint + warm / capacity[0] * (initial_c - setpoint)
+        start_c = box.setpoint_c
+        if initial_c is not None:  # the cargo comes in at the set-point; the rest is warm
+            cargo = np.asarray(payload_kg, dtype=float).flat[0] * box.cargo_specific_heat_j_kgk
+            start_c += (capacity[0] - cargo) / capacity[0] * (initial_c - box.setpoint_c)
         temperature, cooling, heating = _integrate_box(
             box, ambient_c, solar_heat, door_conductance, capacity, dt_s, start_c
         )
-        wall = wall_heat_w(box, ambient_c, temperature)
-        door = door_conductance * (ambient_c - temperature)
         cop = refrigeration_cop(box, ambient_c, temperature)
     power = cooling / cop + heating / box.heating_cop + box.standby_power_w
     above = temperature > box.product_limit_c
     return BoxResult(
         power_w=power,
-        wall_heat_w=wall,
+        wall_heat_w=wall_heat_w(box, ambient_c, temperature),
         solar_heat_w=solar_heat,
-        door_heat_w=door,
+        door_heat_w=door_conductance * (ambient_c - temperature),
         temperature_c=temperature,
-        max_temperature_c=float(temperature.max()) if temperature.size else setpoint,
+        max_temperature_c=float(temperature.max()) if temperature.size else box.setpoint_c,
         minutes_above_limit=float(above.sum() * dt_s / 60.0),
     )
+
+
+def _steady(
+    box: CargoBoxParams,
+    ambient_c: FloatArray,
+    solar_heat: FloatArray,
+    door_conductance: FloatArray,
+    dt_s: float,
+    initial_c: float | None,
+) -> tuple[FloatArray, FloatArray, FloatArray | float]:
+    """The paper's steady box: at its set-point, the unit removing every load (and the heater
+    adding what it loses, if enabled), a structure that starts warm pulled down at the unit's
+    capacity from the start. Temperature [°C], heat removed and added in each step [W]."""
+    setpoint = box.setpoint_c
+    load = wall_heat_w(box, ambient_c, setpoint) + solar_heat
+    load = load + door_conductance * (ambient_c - setpoint)
+    if initial_c is not None:
+        pulldown_j = box.structure_heat_capacity_j_k * (initial_c - setpoint)
+        rate_w = box.refrigeration_capacity_w if pulldown_j > 0 else box.heating_capacity_w
+        load = load + _front_loaded(pulldown_j, rate_w, load.size, dt_s)
+    heating = np.maximum(-load, 0.0) if box.heater_enabled else 0.0
+    return np.full_like(ambient_c, setpoint), np.maximum(load, 0.0), heating
 
 
 def _front_loaded(energy_j: float, power_w: float, n_steps: int, dt_s: float) -> FloatArray:

@@ -200,6 +200,43 @@ def drive_profile(
         Speed samples [m/s] every ``dt_s`` (first and last 0) and the distance driven at each
         sample [m].
     """
+    lengths, targets, mean_speed = _segments(segment_distance_m, segment_speed_mps)
+    total = float(lengths.sum())
+    _check_leg_inputs(total, driver_aggressiveness, traffic_density, dt_s)
+    if total == 0:
+        return np.zeros(1), np.zeros(1)
+    if total / _SEGMENT_SPEED_RANGE_MPS[0] / dt_s > MAX_LEG_SAMPLES:
+        raise LimitExceededError(f"a {total:g} m leg needs too many samples", "distance_m")
+    step_m = max(PROFILE_GRID_M, total / _MAX_PROFILE_POINTS)
+    grid = np.append(np.arange(0.0, total, step_m), total)
+    segment = np.minimum(np.searchsorted(np.cumsum(lengths), grid, side="right"), lengths.size - 1)
+    # The traffic's wave as a slow-down of the road's speed, never above it.
+    density = street.traffic_density if traffic_density is None else traffic_density
+    wave_street = street.model_copy(update={"mean_speed_mps": mean_speed})
+    wave_t, wave_v = _wave_breakpoints(
+        wave_street, driver_aggressiveness * max_acceleration_mps2, density, total / mean_speed
+    )
+    slowdown = np.minimum(wave_v / mean_speed, 1.0)
+    target = targets[segment] * np.interp(
+        grid % (mean_speed * wave_t[-1]), wave_t * mean_speed, slowdown
+    )
+    accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2
+    trace = _in_time(grid, _within_acceleration(grid, target, accel), dt_s)
+    if trace_distance_m(trace, dt_s) == 0:  # a hop shorter than one sample: the plain ramp
+        trace = generate_leg(
+            total, street, driver_aggressiveness, max_acceleration_mps2, None, dt_s
+        )
+    trace *= total / trace_distance_m(trace, dt_s)
+    travelled = np.concatenate(([0.0], np.cumsum(0.5 * (trace[:-1] + trace[1:]) * dt_s)))
+    return trace, travelled
+
+
+def _segments(
+    segment_distance_m: FloatArray, segment_speed_mps: FloatArray
+) -> tuple[FloatArray, FloatArray, float]:
+    """A road's segment lengths [m] and speeds [m/s], checked, with absurd or missing speeds
+    brought within :data:`_SEGMENT_SPEED_RANGE_MPS` (missing ones to the road's mean), and the
+    road's mean speed [m/s]."""
     lengths = np.asarray(segment_distance_m, dtype=float)
     targets = np.asarray(segment_speed_mps, dtype=float)
     if lengths.ndim != 1 or lengths.shape != targets.shape:
@@ -208,59 +245,42 @@ def drive_profile(
         )
     if lengths.size == 0 or not np.all(np.isfinite(lengths) & (lengths >= 0)):
         raise InvalidParameterError("segment distances must be finite and >= 0", "distance_m")
-    total = float(lengths.sum())
-    _check_leg_inputs(total, driver_aggressiveness, traffic_density, dt_s)
-    if total == 0:
-        return np.zeros(1), np.zeros(1)
     low, high = _SEGMENT_SPEED_RANGE_MPS
     moving = lengths > 0
-    mean_speed = float(
-        np.sum(lengths[moving])
-        / np.sum(
-            lengths[moving]
-            / np.clip(np.where(np.isfinite(targets[moving]), targets[moving], low), low, high)
-        )
+    if not moving.any():
+        return lengths, np.full(lengths.size, low), low
+    known = np.clip(np.where(np.isfinite(targets[moving]), targets[moving], low), low, high)
+    mean_speed = float(np.sum(lengths[moving]) / np.sum(lengths[moving] / known))
+    return (
+        lengths,
+        np.clip(np.where(np.isfinite(targets), targets, mean_speed), low, high),
+        mean_speed,
     )
-    targets = np.clip(np.where(np.isfinite(targets), targets, mean_speed), low, high)
-    if total / low / dt_s > MAX_LEG_SAMPLES:
-        raise LimitExceededError(f"a {total:g} m leg needs too many samples", "distance_m")
 
-    step_m = max(PROFILE_GRID_M, total / _MAX_PROFILE_POINTS)
-    grid = np.append(np.arange(0.0, total, step_m), total)
-    ends = np.cumsum(lengths)
-    segment = np.minimum(np.searchsorted(ends, grid, side="right"), lengths.size - 1)
-    target = targets[segment]
 
-    density = street.traffic_density if traffic_density is None else traffic_density
-    wave_street = street.model_copy(update={"mean_speed_mps": mean_speed})
-    wave_t, wave_v = _wave_breakpoints(
-        wave_street, driver_aggressiveness * max_acceleration_mps2, density, total / mean_speed
-    )
-    period_m = mean_speed * wave_t[-1]
-    slowdown = np.minimum(wave_v / mean_speed, 1.0)
-    target = target * np.interp(grid % period_m, wave_t * mean_speed, slowdown)
-
-    accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2
-    squared = target**2
-    squared[0] = squared[-1] = 0.0  # from rest, to rest
-    reach = 2.0 * accel * grid
+def _within_acceleration(
+    grid_m: FloatArray, target_mps: FloatArray, accel_mps2: float
+) -> FloatArray:
+    """The speed on a distance grid [m/s]: the lowest of every target reachable from the start
+    or the end at ``accel_mps2``, ``v(s)² = min_j (v_j² + 2·a·|s − s_j|)``, from rest to rest,
+    with running minima (no loop)."""
+    squared = target_mps**2
+    squared[0] = squared[-1] = 0.0
+    reach = 2.0 * accel_mps2 * grid_m
     forward = reach + np.minimum.accumulate(squared - reach)
     backward = -reach + np.minimum.accumulate((squared + reach)[::-1])[::-1]
-    speed = np.sqrt(np.maximum(np.minimum(forward, backward), 0.0))
+    return np.sqrt(np.maximum(np.minimum(forward, backward), 0.0))
 
-    mean_cell = 0.5 * (speed[:-1] + speed[1:])
-    cell_s = np.diff(grid) / np.maximum(mean_cell, 1e-3)
+
+def _in_time(grid_m: FloatArray, speed_mps: FloatArray, dt_s: float) -> FloatArray:
+    """A speed profile over distance as samples every ``dt_s`` [m/s], ending at rest: time
+    follows from ``ds / v``."""
+    mean_cell = 0.5 * (speed_mps[:-1] + speed_mps[1:])
+    cell_s = np.diff(grid_m) / np.maximum(mean_cell, 1e-3)
     clock = np.concatenate(([0.0], np.cumsum(cell_s)))
-    samples = np.arange(0.0, clock[-1] + dt_s, dt_s)
-    trace: FloatArray = np.interp(samples, clock, speed)
+    trace: FloatArray = np.interp(np.arange(0.0, clock[-1] + dt_s, dt_s), clock, speed_mps)
     trace[-1] = 0.0
-    if trace_distance_m(trace, dt_s) == 0:  # a hop shorter than one sample: the plain ramp
-        trace = generate_leg(
-            total, street, driver_aggressiveness, max_acceleration_mps2, None, dt_s
-        )
-    trace *= total / trace_distance_m(trace, dt_s)
-    travelled = np.concatenate(([0.0], np.cumsum(0.5 * (trace[:-1] + trace[1:]) * dt_s)))
-    return trace, travelled
+    return trace
 
 
 def _check_leg_inputs(

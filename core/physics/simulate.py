@@ -231,7 +231,120 @@ def simulate(
     payload = van.payload_kg if payload_kg is None else payload_kg
     payload_step = _per_step(payload, n, "payload_kg", 0.0, 40_000.0)
     end_s = (n - 1) * dt_s
-    for name, windows in (("door_openings", door_openings), ("parked", parked)):
+    _check_within(end_s, door_openings=door_openings, parked=parked)
+    check_representable(start, end_s)
+    time_s = np.arange(n) * dt_s
+    outside = _environment(start, location, van, weather, n - 1, dt_s)
+    power, box, cab_gap_j = _consumers(
+        van, speed, dt_s, outside, grade_step, payload_step, door_openings, parked, heading_deg
+    )
+    soc, verdict, loss_j = _battery(van, power, dt_s, outside)
+    grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c)
+    return SimulationResult(
+        time_s=time_s,
+        speed_mps=speed,
+        power_w=power,
+        energy_kwh=_energy_kwh(power, dt_s),
+        battery_loss_kwh=loss_j / battery_model.JOULES_PER_KWH,
+        grid_kwh=grid_j / battery_model.JOULES_PER_KWH if van.precondition_at_depot else 0.0,
+        distance_m=trace_distance_m(speed, dt_s),
+        duration_s=end_s,
+        soc=soc,
+        battery=verdict,
+        box=box,
+        ambient_c=outside.ambient_c,
+        weather=outside.first_day,
+        weather_days=outside.days,
+        weather_source=outside.source,
+    )
+
+
+def _consumers(
+    van: VanParams,
+    speed: FloatArray,
+    dt_s: float,
+    outside: _Environment,
+    grade_step: FloatArray | float,
+    payload_step: FloatArray | float,
+    door_openings: Sequence[DoorOpening],
+    parked: Sequence[Interval],
+    heading_deg: ArrayLike | None,
+) -> tuple[dict[str, FloatArray], BoxResult, float]:
+    """Each consumer's power over each step [W] (:data:`CONSUMERS`), the box, and the energy a
+    cab at the outside temperature needs to reach 20 °C [J]."""
+    n_steps = speed.size - 1
+    box = refrigeration(
+        van.cargo_box,
+        outside.ambient_c,
+        outside.solar_heat_w,
+        door_open_fraction(door_openings, np.arange(1, n_steps + 1) * dt_s, dt_s),
+        np.broadcast_to(payload_step, outside.ambient_c.shape),
+        dt_s,
+        initial_c=None if van.precondition_at_depot else outside.start_c,
+    )
+    cab_gap_j = _cab_gap_j(van, outside.start_c)
+    power = {
+        "traction": step_traction_power_w(
+            van.vehicle,
+            speed,
+            dt_s,
+            van.vehicle.mass_kg + payload_step,
+            grade_step,
+            _headwind_mps(outside, heading_deg, speed.size),
+        ),
+        "auxiliaries": auxiliaries_power_w(van.vehicle, n_steps),
+        "cabin": _cabin_power_w(van, outside, dt_s, parked, cab_gap_j),
+        "refrigeration": box.power_w,
+    }
+    return power, box, cab_gap_j
+
+
+def _battery(
+    van: VanParams, power_w: dict[str, FloatArray], dt_s: float, outside: _Environment
+) -> tuple[FloatArray, battery_model.BatteryVerdict, float]:
+    """The state of charge at every sample, the verdict, and the battery's own loss in the
+    cold or heat [J]."""
+    consumer_j = sum(power_w.values(), np.zeros(outside.ambient_c.size)) * dt_s
+    drawn_j = battery_model.battery_energy_j(van.battery, consumer_j, outside.ambient_c)
+    usable_share = battery_model.capacity_factor(van.battery, outside.start_c)
+    soc, verdict = battery_model.discharge(van.battery, drawn_j, usable_share)
+    return soc, verdict, float((drawn_j - consumer_j).sum())
+
+
+def _cabin_power_w(
+    van: VanParams,
+    outside: _Environment,
+    dt_s: float,
+    parked: Sequence[Interval],
+    cab_gap_j: float,
+) -> FloatArray:
+    """The cab HVAC's power of each step [W]: a cab not pre-conditioned starts ``cab_gap_j``
+    away from 20 °C."""
+    return cab_power_w(
+        van.vehicle,
+        outside.ambient_c,
+        dt_s,
+        [(p.start_s, p.duration_s) for p in parked],
+        0.0 if van.precondition_at_depot else cab_gap_j,
+        outside.cab_hvac_w,
+    )
+
+
+def _headwind_mps(
+    outside: _Environment, heading_deg: ArrayLike | None, n: int
+) -> FloatArray | float:
+    """Wind against the direction of travel in each step [m/s]; 0 in calm air or without
+    headings."""
+    if heading_deg is None or outside.calm:
+        return 0.0
+    return headwind_mps(
+        outside.wind_from_east_mps, outside.wind_from_north_mps, _step_heading(heading_deg, n)
+    )
+
+
+def _check_within(end_s: float, **intervals: Sequence[Interval]) -> None:
+    """Every interval starts within the trace (``end_s`` its last moment [s])."""
+    for name, windows in intervals.items():
         for index, window in enumerate(windows):
             if window.start_s > end_s:
                 raise InvalidParameterError(
@@ -239,91 +352,32 @@ def simulate(
                     f"({end_s} s)",
                     f"{name}[{index}].start_s",
                 )
-    check_representable(start, end_s)
 
-    time_s = np.arange(n) * dt_s
-    step_end = time_s[1:]
-    outside = _environment(start, location, van, weather, n - 1, dt_s)
-    ambient = outside.ambient_c
-    box_params = van.cargo_box
-    box = refrigeration(
-        box_params,
-        ambient,
-        outside.solar_heat_w,
-        door_open_fraction(door_openings, step_end, dt_s),
-        np.broadcast_to(payload_step, ambient.shape),
-        dt_s,
-        initial_c=None if van.precondition_at_depot else outside.start_c,
-    )
+
+def _cab_gap_j(van: VanParams, outside_c: float) -> float:
+    """Electric energy to bring a cab at the outside temperature to 20 °C [J]."""
     vehicle = van.vehicle
-    cab_gap_j = (
-        vehicle.cab_recovery_energy_j_k
-        * abs(CAB_SETPOINT_C - outside.start_c)
-        * float(cabin_hvac_power_w(vehicle, outside.start_c) > 0)
-    )
-    headwind = (
-        0.0
-        if heading_deg is None or outside.calm
-        else headwind_mps(
-            outside.wind_from_east_mps,
-            outside.wind_from_north_mps,
-            _step_heading(heading_deg, n),
-        )
-    )
-    power = {
-        "traction": step_traction_power_w(
-            vehicle, speed, dt_s, vehicle.mass_kg + payload_step, grade_step, headwind
-        ),
-        "auxiliaries": auxiliaries_power_w(vehicle, n - 1),
-        "cabin": cab_power_w(
-            vehicle,
-            ambient,
-            dt_s,
-            [(p.start_s, p.duration_s) for p in parked],
-            0.0 if van.precondition_at_depot else cab_gap_j,
-            outside.cab_hvac_w,
-        ),
-        "refrigeration": box.power_w,
-    }
+    heated = float(cabin_hvac_power_w(vehicle, outside_c) > 0)
+    return vehicle.cab_recovery_energy_j_k * abs(CAB_SETPOINT_C - outside_c) * heated
+
+
+def _energy_kwh(power_w: dict[str, FloatArray], dt_s: float) -> dict[str, float]:
+    """Each consumer's energy and the total [kWh]; a consumer without a finite energy is an
+    error naming the parameters behind it (a last guard for parameters at the edges of their
+    ranges, combined)."""
     energy = {
-        name: float(p.sum() * dt_s / battery_model.JOULES_PER_KWH) for name, p in power.items()
+        name: float(p.sum() * dt_s / battery_model.JOULES_PER_KWH) for name, p in power_w.items()
     }
     energy["total"] = sum(energy.values())
     broken = [name for name, value in energy.items() if not np.isfinite(value)]
-    if broken:  # a last guard: parameters at the edges of their ranges, combined
+    if broken:
+        box = broken[0] == "refrigeration"
         raise InvalidParameterError(
             f"the van's parameters give no finite {broken[0]} energy; check the "
-            f"{'cargo box' if broken[0] == 'refrigeration' else 'vehicle'} parameters",
-            "cargo_box" if broken[0] == "refrigeration" else "vehicle",
+            f"{'cargo box' if box else 'vehicle'} parameters",
+            "cargo_box" if box else "vehicle",
         )
-    consumer_j = sum(power.values(), np.zeros(n - 1)) * dt_s
-    battery_params = van.battery
-    drawn_j = battery_model.battery_energy_j(battery_params, consumer_j, ambient)
-    usable_share = battery_model.capacity_factor(battery_params, outside.start_c)
-    soc, verdict = battery_model.discharge(battery_params, drawn_j, usable_share)
-    grid_j = (
-        cab_gap_j + precondition_energy_j(box_params, outside.start_c)
-        if van.precondition_at_depot
-        else 0.0
-    )
-    first_day = outside.days[0]
-    return SimulationResult(
-        time_s=time_s,
-        speed_mps=speed,
-        power_w=power,
-        energy_kwh=energy,
-        battery_loss_kwh=float((drawn_j - consumer_j).sum() / battery_model.JOULES_PER_KWH),
-        grid_kwh=grid_j / battery_model.JOULES_PER_KWH,
-        distance_m=trace_distance_m(speed, dt_s),
-        duration_s=end_s,
-        soc=soc,
-        battery=verdict,
-        box=box,
-        ambient_c=ambient,
-        weather=Weather(t_min_c=round(first_day.t_min_c, 2), t_max_c=round(first_day.t_max_c, 2)),
-        weather_days=outside.days,
-        weather_source=outside.source,
-    )
+    return energy
 
 
 def door_open_fraction(
@@ -357,6 +411,12 @@ class _Environment:
     calm: bool
     days: list[DayWeather]
     source: WeatherSource
+
+    @property
+    def first_day(self) -> Weather:
+        """The first day's extremes, rounded to a hundredth of a kelvin [°C]."""
+        day = self.days[0]
+        return Weather(t_min_c=round(day.t_min_c, 2), t_max_c=round(day.t_max_c, 2))
 
 
 def _environment(

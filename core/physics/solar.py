@@ -12,7 +12,7 @@ from core.params import CargoBoxParams
 
 # ASHRAE clear-sky model, monthly apparent extraterrestrial irradiance A [W/m²] and
 # atmospheric extinction coefficient B [–], January → December (ASHRAE Handbook –
-# Fundamentals 1985, ch. 27; as listed in shared/DESIGN.md).
+# Fundamentals 1985, ch. 27; docs/architecture.md lists them with the paper's eq. 13).
 ASHRAE_A_W_M2 = np.array(
     [1230, 1215, 1186, 1136, 1104, 1088, 1085, 1107, 1151, 1192, 1221, 1233], dtype=float
 )

@@ -3,7 +3,7 @@
 A speed trace sampled every ``dt_s`` seconds is simulated step by step: step ``k`` runs from
 sample ``k-1`` to sample ``k``. Each step uses the mean of its start and end speed for drag and
 power and the speed change over the step for inertia; using the end speed alone overstates
-city-cycle energy by up to 10 % (shared/reference/cycles/REFERENCE.md).
+city-cycle energy by up to 10 % (docs/validation.md).
 """
 
 from __future__ import annotations

@@ -239,7 +239,7 @@ def _season_plan(
         return plan(problem, router, weather_service)
     except CoreError as error:
         if error.field in ("date", "start_time"):
-            raise type(error)(error.message, f"seasons[{index}].date") from None
+            raise error.at(f"seasons[{index}].date") from None
         raise
 
 

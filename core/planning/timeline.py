@@ -255,13 +255,13 @@ def later_departure_s(
     before each stop, and beyond them shifts the stop's service, which must stay inside its
     window (the forward time slack of Savelsbergh, *ORSA J. Computing* 4 (1992) 146)."""
     waited = 0.0
-    slack = (
-        math.inf if latest_return_s is None else latest_return_s - timeline.leave[-1] * PLAN_DT_S
-    )
+    slack = math.inf
     for k, j in enumerate(order[1:-1]):
         served_s = timeline.serve[k] * PLAN_DT_S
         waited += served_s - timeline.arrive[k] * PLAN_DT_S
         window = next_window(served_s, windows_s[j])
         closes = math.inf if window is None else window[1]
         slack = min(slack, waited + closes - served_s)
+    if latest_return_s is not None:  # the return moves only by what the waits do not absorb
+        slack = min(slack, waited + latest_return_s - timeline.leave[-1] * PLAN_DT_S)
     return float(max(min(waited, slack), 0.0) // PLAN_DT_S * PLAN_DT_S)

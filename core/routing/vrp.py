@@ -93,12 +93,9 @@ class RoutingInput:
 
 @dataclass(frozen=True)
 class RoutingOutcome:
-    """Stops of each van in driving order (no depot), the stops left out, and the search."""
+    """Stops of each van in driving order (no depot); a stop in no route is left out."""
 
     routes: list[list[int]]
-    dropped: list[int]
-    cost: int
-    runtime_s: float
 
 
 def solve_routes(
@@ -116,9 +113,43 @@ def solve_routes(
         Routes to start from (stops per van); ignored when they break a constraint.
     """
     started = time.perf_counter()
+    manager, routing = _model(problem)
+    params = pywrapcp.DefaultRoutingSearchParameters()
+    params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.PATH_CHEAPEST_ARC
+    params.local_search_metaheuristic = (
+        routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
+    )
+    params.solution_limit = SOLUTIONS_PER_STOP * max(problem.travel_s.shape[0] - 1, 1)
+    budget_s = time_limit_s - (time.perf_counter() - started) - _STOP_MARGIN_S
+    params.time_limit.FromMilliseconds(max(int(budget_s * 1000), 1))
+    routing.CloseModelWithParameters(params)
+    solution = None
+    if initial is not None:
+        start = routing.ReadAssignmentFromRoutes(
+            [[manager.NodeToIndex(node) for node in route] for route in initial], True
+        )
+        if start is not None:
+            solution = routing.SolveFromAssignmentWithParameters(start, params)
+    if solution is None:
+        solution = routing.SolveWithParameters(params)
+    if solution is None:
+        return None
+    routes: list[list[int]] = []
+    for v in range(len(problem.vehicles)):
+        index = solution.Value(routing.NextVar(routing.Start(v)))
+        route = []
+        while not routing.IsEnd(index):
+            route.append(manager.IndexToNode(index))
+            index = solution.Value(routing.NextVar(index))
+        routes.append(route)
+    return RoutingOutcome(routes)
+
+
+def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapcp.RoutingModel]:
+    """The routing model: each van's arc costs and fixed cost; the time, payload and energy
+    dimensions; a disjunction per stop."""
     n = problem.travel_s.shape[0]
-    n_vehicles = len(problem.vehicles)
-    manager = pywrapcp.RoutingIndexManager(n, n_vehicles, 0)
+    manager = pywrapcp.RoutingIndexManager(n, len(problem.vehicles), 0)
     routing = pywrapcp.RoutingModel(manager)
     callbacks: dict[int, int] = {}
 
@@ -132,7 +163,6 @@ def solve_routes(
     for v, vehicle in enumerate(problem.vehicles):
         routing.SetArcCostEvaluatorOfVehicle(matrix_callback(vehicle.arc_cost), v)
         routing.SetFixedCostOfVehicle(int(vehicle.fixed_cost), v)
-
     horizon = int(problem.horizon_s)
     time_matrix = np.minimum(problem.travel_s + problem.service_s[:, None], horizon + 1)
     routing.AddDimension(matrix_callback(time_matrix), horizon, horizon + 1, False, "time")
@@ -151,12 +181,10 @@ def solve_routes(
         clock.CumulVar(routing.Start(v)).SetRange(first, last)
         clock.CumulVar(routing.End(v)).SetRange(first, last)
         clock.SetSlackCostCoefficientForVehicle(int(vehicle.wait_cost_per_s), v)
-
     demand = routing.RegisterUnaryTransitVector(problem.demand_g.tolist())
     routing.AddDimensionWithVehicleCapacity(
         demand, 0, [int(v.payload_capacity_g) for v in problem.vehicles], True, "payload"
     )
-
     if any(v.energy is not None for v in problem.vehicles):
         zero = np.zeros((n, n), dtype=np.int64)
         routing.AddDimensionWithVehicleTransitAndCapacity(
@@ -166,43 +194,6 @@ def solve_routes(
             True,
             "energy",
         )
-
     for node in range(1, n):
         routing.AddDisjunction([manager.NodeToIndex(node)], int(problem.drop_penalty))
-
-    params = pywrapcp.DefaultRoutingSearchParameters()
-    params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.PATH_CHEAPEST_ARC
-    params.local_search_metaheuristic = (
-        routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
-    )
-    params.solution_limit = SOLUTIONS_PER_STOP * max(n - 1, 1)
-    budget_s = time_limit_s - (time.perf_counter() - started) - _STOP_MARGIN_S
-    params.time_limit.FromMilliseconds(max(int(budget_s * 1000), 1))
-    routing.CloseModelWithParameters(params)
-
-    solution = None
-    if initial is not None:
-        start = routing.ReadAssignmentFromRoutes(
-            [[manager.NodeToIndex(node) for node in route] for route in initial], True
-        )
-        if start is not None:
-            solution = routing.SolveFromAssignmentWithParameters(start, params)
-    if solution is None:
-        solution = routing.SolveWithParameters(params)
-    if solution is None:
-        return None
-    routes: list[list[int]] = []
-    for v in range(n_vehicles):
-        index = solution.Value(routing.NextVar(routing.Start(v)))
-        route = []
-        while not routing.IsEnd(index):
-            route.append(manager.IndexToNode(index))
-            index = solution.Value(routing.NextVar(index))
-        routes.append(route)
-    served = {node for route in routes for node in route}
-    return RoutingOutcome(
-        routes=routes,
-        dropped=[node for node in range(1, n) if node not in served],
-        cost=int(solution.ObjectiveValue()),
-        runtime_s=time.perf_counter() - started,
-    )
+    return manager, routing

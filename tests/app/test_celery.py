@@ -3,12 +3,15 @@ test machines (127.0.0.1:5432 database ``test``, 127.0.0.1:6379), real worker pr
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 import uuid
+from collections.abc import Iterator
 
 import httpx
 import psycopg
@@ -18,20 +21,20 @@ import redis
 from app.examples import PLAN_EXAMPLE
 from benchmarks.common import Server
 from tests.app.serving import children, long_plan
-from tests.app.test_jobs import _cpu_busy, submit, wait_for
+from tests.app.test_jobs import _cpu_busy, assert_spaced, submit, wait_for
+from tests.router_stub import DownRouter
 
 POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
 REDIS_DB = 11
 
 
-@pytest.fixture(scope="module")
-def services():
-    """A schema of our own in PostgreSQL and an empty Redis database."""
+@contextlib.contextmanager
+def own_services() -> Iterator[dict[str, str]]:
+    """A schema of our own in PostgreSQL and a queue of our own on Redis: the settings."""
     schema = f"coldroute_{uuid.uuid4().hex[:10]}"
     with psycopg.connect(POSTGRES, autocommit=True) as connection:
         connection.execute(f"CREATE SCHEMA {schema}")
     broker = f"redis://127.0.0.1:6379/{REDIS_DB}"
-    redis.Redis.from_url(broker).flushdb()
     env = {
         "COLDROUTE_DATABASE_URL": "postgresql+psycopg://postgres@127.0.0.1:5432/test"
         f"?options=-csearch_path%3D{schema}",
@@ -41,10 +44,21 @@ def services():
         "COLDROUTE_JOB_STALE_AFTER_S": "3",
         "COLDROUTE_WORKERS": "1",
     }
-    yield env
-    redis.Redis.from_url(broker).flushdb()
-    with psycopg.connect(POSTGRES, autocommit=True) as connection:
-        connection.execute(f"DROP SCHEMA {schema} CASCADE")
+    try:
+        yield env
+    finally:
+        with psycopg.connect(POSTGRES, autocommit=True) as connection:
+            connection.execute(f"DROP SCHEMA {schema} CASCADE")
+
+
+@pytest.fixture(scope="module")
+def services():
+    """The module's schema and an empty Redis database."""
+    broker = redis.Redis.from_url(f"redis://127.0.0.1:6379/{REDIS_DB}")
+    broker.flushdb()
+    with own_services() as env:
+        yield env
+    broker.flushdb()
 
 
 class Worker:
@@ -156,3 +170,55 @@ def test_cancel_a_running_celery_job(server, workers):
     assert wait_for(server.url, following, timeout=60)["status"] == "succeeded"
     assert time.monotonic() - stopped_at < 20
     assert httpx.get(f"{server.url}/v1/jobs/{job_id}").json()["status"] == "cancelled"
+
+
+class Messages:
+    """Every task message sent to a queue, counted from Redis's MONITOR stream."""
+
+    def __init__(self, queue: str) -> None:
+        self.queue = queue
+        self.sent: list[float] = []
+        self._stop = False
+        self._client = redis.Redis(port=6379, db=REDIS_DB)
+        self._thread = threading.Thread(target=self._watch, daemon=True)
+        self._thread.start()
+        time.sleep(0.3)
+
+    def _watch(self) -> None:
+        with self._client.monitor() as monitor:
+            for command in monitor.listen():
+                if self._stop:
+                    return
+                words = command["command"].split(" ", 2)
+                if words[0].upper() == "LPUSH" and words[1].strip('"') == self.queue:
+                    self.sent.append(time.time())
+
+    def stop(self) -> None:
+        self._stop = True
+        self._client.ping()  # one more command, so that the monitor loop sees the flag
+
+
+def test_a_job_whose_router_is_down_is_retried_after_its_backoff_one_message_each():
+    router = DownRouter()
+    with own_services() as env:
+        env |= {
+            "COLDROUTE_OSRM_URL": router.url,
+            "COLDROUTE_JOB_MAX_ATTEMPTS": "3",
+            "COLDROUTE_JOB_RETRY_BACKOFF_S": "[3, 6]",
+        }
+        messages = Messages(env["COLDROUTE_BROKER_QUEUE"])
+        worker = Worker(env, "retrying")
+        server = Server(env).start()
+        try:
+            job_id = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+            done = wait_for(server.url, job_id, timeout=90)
+        finally:
+            server.close()
+            worker.stop()
+            messages.stop()
+            router.stop()
+    assert done["status"] == "failed" and done["attempts"] == 3
+    assert done["error"]["service"] == "osrm"
+    # Three attempts 3 s then 6 s apart (the dispatcher looks every 2 s), one message each.
+    assert_spaced(router.table_calls, [3, 6], slack_s=3.5)
+    assert len(messages.sent) == 3, messages.sent

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import itertools
 import os
 import signal
 import tempfile
@@ -15,6 +16,7 @@ import pytest
 from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE, SCENARIOS_EXAMPLE
 from benchmarks.common import Server
 from tests.app.serving import alive, children, long_plan
+from tests.router_stub import DownRouter
 
 FAST = {
     "COLDROUTE_WORKERS": "2",
@@ -132,6 +134,86 @@ def test_bad_input_is_a_422_at_submission(server, body, field):
     assert response.status_code == 422
     assert response.headers["content-type"] == "application/problem+json"
     assert any(e["field"] == field for e in response.json()["errors"]), response.json()
+
+
+@pytest.mark.parametrize(
+    ("kind", "body"),
+    [
+        (
+            "plan",
+            PLAN_EXAMPLE
+            | {
+                "cargo_box": {"product_limit_c": 2},
+                "battery": {"initial_soc": 0.5, "min_soc": 0.6},
+            },
+        ),
+        (
+            "fleet-plan",
+            FLEET_PLAN_EXAMPLE
+            | {
+                "vehicles": [
+                    FLEET_PLAN_EXAMPLE["vehicles"][0]
+                    | {
+                        "cargo_box": {"setpoint_c": 8, "product_limit_c": 6},
+                        "battery": {"initial_soc": 0.5, "min_soc": 0.6},
+                    }
+                ]
+            },
+        ),
+        (
+            "scenarios",
+            SCENARIOS_EXAMPLE
+            | {
+                "plan": PLAN_EXAMPLE
+                | {"battery": {"min_soc": 0.995}, "cargo_box": {"product_limit_c": 2}}
+            },
+        ),
+    ],
+)
+def test_a_job_names_every_bad_field_the_endpoint_names(client, kind, body):
+    # The same request, synchronously and as a job: the same entries, under request.
+    endpoint = {"plan": "/v1/plans", "fleet-plan": "/v1/fleet-plans"}.get(
+        kind, "/v1/studies/scenarios"
+    )
+    direct = client.post(endpoint, json=body)
+    as_job = client.post("/v1/jobs", json={"type": kind, "request": body})
+    assert direct.status_code == as_job.status_code == 422
+    named = [(e["field"], e["message"]) for e in direct.json()["errors"]]
+    assert len(named) >= 2
+    assert [(e["field"], e["message"]) for e in as_job.json()["errors"]] == [
+        (f"request.{field}", message) for field, message in named
+    ]
+
+
+def assert_spaced(calls: list[float], backoff_s: list[float], slack_s: float) -> None:
+    """Attempts at the times of ``calls``, each after the backoff before it (and not much
+    later)."""
+    gaps = [b - a for a, b in itertools.pairwise(calls)]
+    assert len(gaps) == len(backoff_s), calls
+    for gap, wait_s in zip(gaps, backoff_s, strict=True):
+        assert wait_s <= gap < wait_s + slack_s, (gaps, backoff_s)
+
+
+def test_a_job_whose_router_is_down_is_retried_after_its_backoff():
+    router = DownRouter()
+    server = Server(
+        FAST
+        | {
+            "COLDROUTE_OSRM_URL": router.url,
+            "COLDROUTE_JOB_MAX_ATTEMPTS": "3",
+            "COLDROUTE_JOB_RETRY_BACKOFF_S": "[2, 4]",
+        }
+    ).start()
+    try:
+        job_id = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+        done = wait_for(server.url, job_id, timeout=60)
+    finally:
+        server.close()
+        router.stop()
+    # Three attempts, 2 s then 4 s apart; then failed, and the failure can be read.
+    assert done["status"] == "failed" and done["attempts"] == 3
+    assert done["error"]["status"] == 503 and done["error"]["service"] == "osrm"
+    assert_spaced(router.table_calls, [2, 4], slack_s=1.5)
 
 
 def test_an_idempotency_key_returns_the_same_job(server):

@@ -5,17 +5,13 @@ route holds in its full simulation."""
 from __future__ import annotations
 
 import datetime as dt
-from zoneinfo import ZoneInfo
 
 import numpy as np
 import pytest
 
 from core.exceptions import CoreError
 from core.params import (
-    PRESETS,
     BatteryParams,
-    Depot,
-    RoadMatrix,
     Stop,
     TimeWindow,
     VanParams,
@@ -25,60 +21,7 @@ from core.planning.fleet import plan_fleet
 from core.planning.model import FleetProblem, FleetResult, FleetVehicle, PlanProblem
 from core.planning.round import plan
 from core.routing.roads import LegRoute, RoadTable
-
-VIENNA = ZoneInfo("Europe/Vienna")
-DAY = dt.date(2026, 7, 15)
-SUMMER = Weather(t_min_c=18, t_max_c=31)
-DEPOT = Depot(id="depot", lat=48.17, lon=16.42)
-VAN = PRESETS["paper-generic"].van()
-
-
-def at(hhmm: str) -> dt.datetime:
-    return dt.datetime.combine(DAY, dt.time.fromisoformat(hhmm), tzinfo=VIENNA)
-
-
-def window(start: str, end: str) -> TimeWindow:
-    return TimeWindow(start=start, end=end)
-
-
-def two_clusters(service_s: float = 300.0, **changes) -> tuple[list[Stop], RoadMatrix]:
-    """East stops E1–E3 and west stops W1–W3, 10 min from the depot, 2 min apart within a
-    cluster and 30 min across; 5 km per 10 min."""
-    names = ["E1", "E2", "E3", "W1", "W2", "W3"]
-    stops = [
-        Stop(id=name, lat=48.17 + 0.001 * k, lon=16.42, service_time_s=service_s, **changes)
-        for k, name in enumerate(names, start=1)
-    ]
-    n = 7
-    minutes = np.zeros((n, n))
-    for i in range(1, n):
-        minutes[0, i] = minutes[i, 0] = 10
-        for j in range(1, n):
-            if i != j:
-                minutes[i, j] = 2 if (i <= 3) == (j <= 3) else 30
-    matrix = RoadMatrix(distances_m=(minutes * 500).tolist(), durations_s=(minutes * 60).tolist())
-    return stops, matrix
-
-
-def fleet(stops, vehicles, **fields) -> FleetProblem:
-    return FleetProblem(
-        date=DAY,
-        timezone="Europe/Vienna",
-        depot=DEPOT,
-        stops=stops,
-        vehicles=vehicles,
-        weather=SUMMER,
-        **fields,
-    )
-
-
-def van(vehicle_id: str, start: str = "08:00", end: str = "17:00", **changes) -> FleetVehicle:
-    return FleetVehicle(
-        id=vehicle_id,
-        van=VAN.model_copy(update=changes),
-        shift_start=dt.time.fromisoformat(start),
-        shift_end=dt.time.fromisoformat(end),
-    )
+from tests.utils.fleets import DAY, DEPOT, SUMMER, VAN, at, fleet, two_clusters, van, window
 
 
 def assert_holds(result: FleetResult, problem: FleetProblem) -> None:

@@ -1,0 +1,102 @@
+"""The routing solver on instances small enough to know the optimum by hand: places on a line
+(node k at k km from the depot, one minute per km)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from core.routing.units import (
+    energy_units_down,
+    energy_units_up,
+    payload_units_down,
+    payload_units_up,
+)
+from core.routing.vrp import RoutingInput, VehicleSpec, solve_routes
+
+
+def line(positions: list[int]) -> np.ndarray:
+    xs = np.array([0, *positions])
+    return np.abs(xs[:, None] - xs[None, :]).astype(np.int64)
+
+
+def problem(
+    positions: list[int],
+    vans: int = 1,
+    windows: list[list[tuple[int, int]]] | None = None,
+    demand: list[int] | None = None,
+    payload: int = 10**9,
+    energy_capacity: int | None = None,
+    horizon: int = 10_000,
+    fixed: int = 0,
+) -> RoutingInput:
+    km = line(positions)
+    n = km.shape[0]
+    vehicle = VehicleSpec(
+        arc_cost=km * 1000,  # metres
+        energy=None if energy_capacity is None else km * 10,
+        energy_capacity=energy_capacity or 0,
+        payload_capacity_g=payload,
+        shift_s=(0, horizon),
+        fixed_cost=fixed,
+    )
+    return RoutingInput(
+        travel_s=km * 60,
+        service_s=np.zeros(n, dtype=np.int64),
+        windows_s=windows or [[] for _ in range(n)],
+        demand_g=np.array([0, *(demand or [0] * (n - 1))], dtype=np.int64),
+        vehicles=[vehicle] * vans,
+        horizon_s=horizon,
+        drop_penalty=10**9,
+    )
+
+
+def cost(routes: list[list[int]], positions: list[int]) -> int:
+    km = line(positions)
+    return sum(int(km[[0, *r], [*r, 0]].sum()) for r in routes if r)
+
+
+def test_one_van_drives_out_and_back():
+    positions = [3, 1, 4, 2]
+    outcome = solve_routes(problem(positions), 1.0)
+    assert outcome is not None
+    # Out to 4 km and back: 8 km whatever the order, but only the sorted order does it.
+    assert cost(outcome.routes, positions) == 8
+
+
+def test_payload_splits_the_stops_between_two_vans():
+    # Two stops at 1 km, two at 5 km; 2 kg each, 4 kg per van: each van takes a pair.
+    positions = [1, 1, 5, 5]
+    outcome = solve_routes(problem(positions, vans=2, demand=[2000] * 4, payload=4000), 1.0)
+    assert outcome is not None
+    assert sorted(sorted(r) for r in outcome.routes) == [[1, 2], [3, 4]]
+    assert cost(outcome.routes, positions) == 2 + 10
+
+
+def test_windows_order_the_stops():
+    # Node 1 (1 km) only after 10 min, node 2 (3 km) before 5 min: 2 first, then 1.
+    positions = [1, 3]
+    windows = [[], [(600, 10_000)], [(0, 300)]]
+    outcome = solve_routes(problem(positions, windows=windows), 1.0)
+    assert outcome is not None and outcome.routes == [[2, 1]]
+
+
+def test_energy_is_a_constraint_and_an_impossible_stop_is_left_out():
+    # 10 units per km; 60 units take the van to 3 km and back, not to 4.
+    positions = [1, 3, 4]
+    outcome = solve_routes(problem(positions, energy_capacity=60), 1.0)
+    assert outcome is not None
+    assert sorted(outcome.routes[0]) == [1, 2]
+
+
+def test_a_fixed_cost_keeps_the_second_van_home():
+    positions = [1, 1]
+    outcome = solve_routes(problem(positions, vans=2, fixed=10**6), 1.0)
+    assert outcome is not None
+    assert sorted(len(r) for r in outcome.routes) == [0, 2]
+
+
+def test_the_solver_units_round_what_is_taken_up_and_limits_down():
+    assert energy_units_up([360.0, 360.1]).tolist() == [1, 2]
+    assert energy_units_down(719.9) == 1
+    assert payload_units_up([0.3, 60.0]).tolist() == [300, 60_000]
+    assert payload_units_down(0.0015) == 1
