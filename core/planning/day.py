@@ -1,7 +1,7 @@
 """The day as a fleet search sees it, fixed for the whole search: the vans and their shifts in
 seconds after the day's first departure, each place's windows, service and demand in the
 solver's units, the arcs that exist, and each van's estimates (:class:`FleetDay`); and how one
-van's route is simulated (:func:`simulate_van`)."""
+van's route is simulated (:meth:`FleetDay.simulate`)."""
 
 from __future__ import annotations
 
@@ -111,8 +111,28 @@ class FleetDay:
         return f"{at(self.reference, seconds):%H:%M}"
 
     def simulate(self, v: int, route: list[int]) -> PlanResult:
-        """The full simulation of van ``v`` driving ``route`` (stops; the depot around it)."""
-        return simulate_van(self, v, route)
+        """The full simulation of van ``v`` driving ``route`` (stops; the depot around it):
+        windows from its own departure, the router's roads when the legs came from it, back by
+        its shift's end."""
+        shift = self.shifts[v]
+        order = [0, *route, 0]
+        origin = self.reference.timestamp() - shift.start.timestamp()
+        windows = [[(a + origin, b + origin) for a, b in place] for place in self.windows_s]
+        roads = (
+            leg_roads(self.router, self.scene.places, order)
+            if self.router is not None and self.scene.legs.source == "osrm"
+            else None
+        )
+        return simulate_route(
+            shift.problem,
+            self.scene,
+            order,
+            shift.start,
+            roads,
+            Solved("feasible", self.estimates[v].route_cost(route), 0.0),
+            windows,
+            None if shift.end is None else shift.end.timestamp() - shift.start.timestamp(),
+        )
 
 
 def fleet_day(shifts: list[VanShift], scene: Scene, router: RoadRouter | None) -> FleetDay:
@@ -170,28 +190,4 @@ def _long_where_no_road(legs: Legs, finite: NDArray[np.bool_]) -> Legs:
         street_type=legs.street_type,
         source=legs.source,
         snap_distance_m=legs.snap_distance_m,
-    )
-
-
-def simulate_van(day: FleetDay, v: int, route: list[int]) -> PlanResult:
-    """The full simulation of van ``v`` driving ``route``: windows from its own departure,
-    the router's roads when the legs came from it, back by its shift's end."""
-    shift = day.shifts[v]
-    order = [0, *route, 0]
-    origin = day.reference.timestamp() - shift.start.timestamp()
-    windows = [[(a + origin, b + origin) for a, b in place] for place in day.windows_s]
-    roads = (
-        leg_roads(day.router, day.scene.places, order)
-        if day.router is not None and day.scene.legs.source == "osrm"
-        else None
-    )
-    return simulate_route(
-        shift.problem,
-        day.scene,
-        order,
-        shift.start,
-        roads,
-        Solved("feasible", day.estimates[v].route_cost(route), 0.0),
-        windows,
-        None if shift.end is None else shift.end.timestamp() - shift.start.timestamp(),
     )
