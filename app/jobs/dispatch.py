@@ -41,9 +41,9 @@ class CeleryDispatcher:
         """How long a sent job may wait to start before its message counts as lost [s]."""
         return max(10 * self.settings.job_stale_after_s, 120.0)
 
-    def submitted(self, job: JobView) -> None:
+    async def submitted(self, job: JobView) -> None:
         """A job was queued: send it now."""
-        self.dispatch(job.id)
+        await asyncio.to_thread(self.dispatch, job.id)
 
     def dispatch(self, job_id: str) -> None:
         """Send one attempt of a job to the workers, unless another dispatcher just did."""

@@ -32,7 +32,7 @@ class LocalRunner:
     def start(self) -> None:
         self._loop_task = asyncio.create_task(self._loop())
 
-    def submitted(self, job: JobView) -> None:
+    async def submitted(self, job: JobView) -> None:
         """A job was queued: look now."""
         self._queued.set()
 
@@ -48,6 +48,7 @@ class LocalRunner:
         last_sweep = 0.0
         loop = asyncio.get_running_loop()
         while True:
+            self._queued.clear()  # before looking: a job queued while we look is seen next
             try:
                 if loop.time() - last_sweep >= SWEEP_EVERY_S:
                     await asyncio.to_thread(self.lifecycle.sweep)
@@ -57,7 +58,6 @@ class LocalRunner:
                         break
             except Exception:  # the database may be briefly away: keep going
                 _log.exception("job runner: housekeeping failed; retrying")
-            self._queued.clear()
             with contextlib.suppress(TimeoutError):
                 await asyncio.wait_for(self._queued.wait(), LOOK_EVERY_S)
 
@@ -71,5 +71,10 @@ class LocalRunner:
         future = await self.executor.start(run_job, job.type, job.request, self.settings)
         watch = asyncio.create_task(asyncio.to_thread(self.lifecycle.watch, job, future))
         self.watching.add(watch)
-        watch.add_done_callback(self.watching.discard)
+        watch.add_done_callback(self._ended)
         return True
+
+    def _ended(self, watch: asyncio.Task[object]) -> None:
+        """A run ended: its slot is free, take the next job now."""
+        self.watching.discard(watch)
+        self._queued.set()

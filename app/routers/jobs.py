@@ -123,7 +123,7 @@ async def create_job(
         ) from None
     runner = getattr(http.app.state, "runner", None)
     if new and runner is not None:
-        await asyncio.to_thread(runner.submitted, job)
+        await runner.submitted(job)
     response.status_code = 202 if new else 200
     response.headers["Location"] = f"/v1/jobs/{job.id}"
     return _out(job)
