@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import datetime as dt
 from dataclasses import dataclass
-from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
+from functools import cache
+from zoneinfo import ZoneInfo, available_timezones
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -42,12 +43,21 @@ def zone_for(timezone: str | None, lon: float) -> tuple[dt.tzinfo, str]:
         sign = "+" if offset >= dt.timedelta(0) else "-"
         name = f"local mean solar time (UTC{sign}{minutes // 60:02d}:{minutes % 60:02d})"
         return dt.timezone(offset), name
-    try:
-        return ZoneInfo(timezone), timezone
-    except (ZoneInfoNotFoundError, ValueError):
+    # Only a zone of the database: a folder of it ("Europe"), one of its files that is not a zone
+    # ("zone.tab") or a path would otherwise reach the file system.
+    if timezone not in _zone_names():
+        shown = timezone if len(timezone) <= 64 else f"{timezone[:64]}…"
         raise InvalidParameterError(
-            f"unknown time zone '{timezone}'; use an IANA name like Europe/Vienna", "timezone"
-        ) from None
+            f"unknown time zone '{shown}'; use an IANA name like Europe/Vienna", "timezone"
+        )
+    return ZoneInfo(timezone), timezone
+
+
+@cache
+def _zone_names() -> frozenset[str]:
+    """Every name of the IANA time-zone database (the tzdata package's, and the system's), but
+    the system's "localtime": the server's own zone, not a client's."""
+    return frozenset(available_timezones()) - {"localtime"}
 
 
 def departure(
@@ -61,6 +71,7 @@ def departure(
     """
     zone, name = zone_for(timezone, lon)
     start = dt.datetime.combine(date, start_time, tzinfo=zone)
+    check_representable(start, 0.0, "date")
     if start.astimezone(UTC).astimezone(zone).replace(tzinfo=None) != start.replace(tzinfo=None):
         raise InvalidParameterError(
             f"{start_time:%H:%M} does not exist on {date} in {name}: the clocks skip it "
@@ -141,13 +152,27 @@ def local_clock(start: dt.datetime, offsets_s: FloatArray) -> LocalClock:
 
 
 def check_representable(start: dt.datetime, duration_s: float, field: str = "start") -> None:
-    """Raise if ``start + duration_s`` is beyond the year 9999 (Python's last datetime), with a
-    day to spare for the local clock and the weather of the last day."""
+    """Raise unless ``start`` to ``start + duration_s`` lies within the years 1 to 9999
+    (Python's datetimes), with a day to spare at both ends for the UTC offset, the local clock
+    and the weather of the first and the last day."""
+    try:
+        at(start, -SECONDS_PER_DAY)
+    except OverflowError:
+        raise InvalidParameterError(
+            f"{_shown(start)} is too close to the start of the year 1, the first one "
+            "the service can represent; plan days from 0001-01-02 on",
+            field,
+        ) from None
     try:
         at(start, duration_s + SECONDS_PER_DAY)
     except OverflowError:
         raise InvalidParameterError(
-            f"{start:%Y-%m-%d %H:%M} plus {duration_s / 3600:,.1f} h runs past the "
+            f"{_shown(start)} plus {duration_s / 3600:,.1f} h runs past the "
             "year 9999, the last one the service can represent",
             field,
         ) from None
+
+
+def _shown(moment: dt.datetime) -> str:
+    """A moment as a person reads it: ISO date (four-digit year) and HH:MM."""
+    return f"{moment.date().isoformat()} {moment:%H:%M}"

@@ -27,21 +27,46 @@ from pydantic import (
 
 from core.exceptions import InvalidParameterError
 
+#: ISO 8601 calendar dates and instants as the API takes them: ASCII digits only (Python's and
+#: pydantic's own parsers also take other scripts' digits, a time of day after a date, numbers).
+DATE_PATTERN = r"^[0-9]{4}-[0-9]{2}-[0-9]{2}$"
+DATETIME_PATTERN = (
+    r"^[0-9]{4}-[0-9]{2}-[0-9]{2}[Tt ][0-9]{2}:[0-9]{2}(:[0-9]{2}([.,][0-9]{1,9})?)?"
+    r"([Zz]|[+-][0-9]{2}:?[0-9]{2})$"
+)
 
-def _iso_text(value: Any) -> Any:
-    """Dates and times come as ISO 8601 text (or as Python's own objects), never as numbers."""
-    if isinstance(value, str | dt.date | dt.time):
-        return value
-    raise ValueError("expected ISO 8601 text")
+
+def _iso_text(pattern: str, example: str) -> Any:
+    """A check that a date or instant comes as ISO 8601 text of ``pattern`` (or as Python's own
+    object), never as a number or in another form."""
+
+    def check(value: Any) -> Any:
+        if isinstance(value, dt.date | dt.time):
+            return value
+        if isinstance(value, str) and re.fullmatch(pattern, value):
+            return value
+        raise ValueError(f"expected ISO 8601 text like {example}")
+
+    return BeforeValidator(check)
 
 
 #: A calendar date from ISO text ("2026-07-15"); see :data:`IsoDateTime`.
-IsoDate = Annotated[dt.date, BeforeValidator(_iso_text), Field(strict=False)]
+IsoDate = Annotated[
+    dt.date,
+    _iso_text(DATE_PATTERN, "2026-07-15"),
+    Field(strict=False),
+    WithJsonSchema({"type": "string", "format": "date", "pattern": DATE_PATTERN}),
+]
 #: An instant with its UTC offset from ISO text ("2026-07-15T09:00:00+02:00").
-IsoDateTime = Annotated[AwareDatetime, BeforeValidator(_iso_text), Field(strict=False)]
+IsoDateTime = Annotated[
+    AwareDatetime,
+    _iso_text(DATETIME_PATTERN, "2026-07-15T09:00:00+02:00"),
+    Field(strict=False),
+    WithJsonSchema({"type": "string", "format": "date-time", "pattern": DATETIME_PATTERN}),
+]
 
-#: A local clock time as the API writes it: HH:MM, 00:00–23:59.
-HHMM_PATTERN = r"^([01]\d|2[0-3]):[0-5]\d$"
+#: A local clock time as the API writes it: HH:MM, 00:00–23:59, ASCII digits.
+HHMM_PATTERN = r"^([01][0-9]|2[0-3]):[0-5][0-9]$"
 
 
 def clock_time(value: Any) -> dt.time:

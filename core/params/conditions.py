@@ -3,7 +3,7 @@ types and drivers of the generated speed traces (§2.2)."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, ValidationInfo, field_validator
 
@@ -48,18 +48,33 @@ class DoorOpening(Interval):
     duration_s: float = Field(..., ge=0, le=86_400, description="How long it stays open [s].")
 
 
+#: Lightest and densest traffic ε_t [–]: the traffic law t_0 = t_p·(1 − ε_t)/ε_t needs
+#: ε_t strictly inside 0..1; beyond these it is constant speed or stop-and-go already.
+MIN_TRAFFIC_DENSITY = 0.01
+MAX_TRAFFIC_DENSITY = 0.99
+
+
+#: A traffic density ε_t [–] as a request gives it.
+TrafficDensity = Annotated[float, Field(ge=MIN_TRAFFIC_DENSITY, le=MAX_TRAFFIC_DENSITY)]
+
+
 class StreetType(Params):
     """Shape of the generated speed trace on one kind of street (paper §2.2)."""
 
-    mean_speed_mps: float = Field(..., gt=0, le=60, description="Mean speed v̄ [m/s].")
+    mean_speed_mps: float = Field(
+        ..., ge=0.5, le=60, description="Mean speed v̄ [m/s]; at least 0.5 m/s."
+    )
     speed_variation: float = Field(
         ..., ge=0, le=1, description="Relative amplitude dv of the trapezoid [–]."
     )
     period_divisor: float = Field(
-        ..., gt=0, le=1000, description="k in t_p = t_NEDC / k [–]: more k, shorter waves."
+        ..., ge=0.1, le=1000, description="k in t_p = t_NEDC / k [–]: more k, shorter waves."
     )
     traffic_density: float = Field(
-        ..., gt=0, lt=1, description="Default traffic density ε_t on this street type [–]."
+        ...,
+        ge=MIN_TRAFFIC_DENSITY,
+        le=MAX_TRAFFIC_DENSITY,
+        description="Default traffic density ε_t on this street type [–], 0.01–0.99.",
     )
 
 
@@ -78,8 +93,14 @@ STREET_TYPES: dict[str, StreetType] = {
     ),
 }
 StreetTypeName = Literal["urban", "highway", "expressway"]
+#: Share of the maximum acceleration a driver at least ramps up and down with at the ends of a
+#: leg (a driver with ε_d = 0, who keeps a constant speed as in the paper's Fig. 10, still has
+#: to start and stop) [–].
+LEAST_RAMP_SHARE = 0.2
 
-#: Driver aggressiveness ε_d of a calm and of an aggressive driver (paper §2.2, Fig. 9).
-CALM_DRIVER = 0.2
+#: Driver aggressiveness ε_d of a calm and of an aggressive driver (paper §2.2, Fig. 9): a calm
+#: driver pulls away at 0.3 · 2 m/s² = 0.6 m/s², the acceleration of economical driving; an
+#: aggressive one at the van's full 2 m/s².
+CALM_DRIVER = 0.3
 NORMAL_DRIVER = 0.5
 AGGRESSIVE_DRIVER = 1.0

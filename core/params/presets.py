@@ -38,6 +38,7 @@ PRESETS: dict[str, Preset] = {
             rolling_resistance_factor=1.0,
             drivetrain_efficiency=0.85,
             regen_efficiency=0.773,
+            max_regen_deceleration_mps2=None,
             air_density_kg_m3=1.2,
             auxiliaries_power_w=250.0,
             cabin_hvac_enabled=False,
@@ -49,7 +50,8 @@ PRESETS: dict[str, Preset] = {
         name="ev-van-3.5t-reefer",
         description="A 3.5 t battery-electric large panel van converted to a chilled reefer, from "
         "published data of the class (68 kWh usable, 317 km WLTP, 135 kW motor; high roof, drag "
-        "area c_d·A_f = 0.34 × 4.5 m²; light-truck tyres of EU label class B, c_r 0.0065): "
+        "area c_d·A_f = 0.34 × 4.5 m²; light-truck tyres of EU label class B, c_r 0.0065; "
+        "regeneration to 0.15 g, up to 70 kW): "
         "2,900 kg with driver, insulation kit and unit (the bare van's WLTP test mass is about "
         "2,450 kg), 500 kg payload; a 9.5 m³ ATP 'IR' box (K = 0.35 W/(m²·K) ≤ 0.4) with an "
         "inverter-driven electric unit (2.5 kW cooling, 1.5 kW heating, 150 W standby, COP a "
@@ -65,6 +67,7 @@ PRESETS: dict[str, Preset] = {
             rolling_resistance_factor=1.0,
             drivetrain_efficiency=0.9,
             regen_efficiency=0.8,
+            max_regen_deceleration_mps2=1.5,
             max_regen_power_w=70_000.0,
             max_motor_power_w=135_000.0,
             max_acceleration_mps2=1.8,

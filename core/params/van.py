@@ -14,22 +14,29 @@ class VehicleParams(Params):
     """The van: longitudinal dynamics (paper §2.1) and the cab's consumers (§2.3)."""
 
     mass_kg: float = Field(
-        1680.0, gt=0, le=40_000, description="Empty vehicle mass incl. driver [kg] (Table 1 m)."
+        1680.0,
+        ge=100,
+        le=40_000,
+        description="Empty vehicle mass incl. driver [kg] (Table 1 m); at least 100 kg.",
     )
     drag_coefficient: float = Field(
-        0.329, gt=0, le=2, description="Aerodynamic drag coefficient c_d [–] (Table 1)."
+        0.329,
+        ge=0.05,
+        le=2,
+        description="Aerodynamic drag coefficient c_d [–] (Table 1); at least 0.05.",
     )
     frontal_area_m2: float = Field(
-        4.27, gt=0, le=20, description="Frontal area A_f [m²] (Table 1)."
+        4.27, ge=0.5, le=20, description="Frontal area A_f [m²] (Table 1); at least 0.5 m²."
     )
     rolling_resistance_coefficient: float = Field(
         0.012, ge=0, le=0.1, description="Rolling-resistance coefficient c_r [–] (Table 1)."
     )
     rolling_resistance_factor: float = Field(
         1.25,
-        gt=0,
+        ge=0.1,
         le=3,
-        description="Factor on m·g·c_r in the rolling force [–]; 1.25 is the paper's eq. 4.",
+        description="Factor on m·g·c_r in the rolling force [–]; 1.25 is the paper's eq. 4; at "
+        "least 0.1.",
     )
     drivetrain_efficiency: float = Field(
         0.85,
@@ -45,16 +52,30 @@ class VehicleParams(Params):
         description="Share of braking power at the wheels returned to the battery [–]; "
         "0 disables regeneration. 0.6 is a conservative van figure (FASTSim's Zoe: 0.773).",
     )
+    max_regen_deceleration_mps2: float | None = Field(
+        0.98,
+        ge=0.1,
+        le=10,
+        description="Deceleration the motor alone brakes with when it regenerates [m/s²]: 0.1 g, "
+        "what lifting off the accelerator gives in an electric van's usual regeneration mode. "
+        "Braking harder blends in the friction brakes, whose share is heat, not charge — why an "
+        "aggressive driver, who brakes hard, regenerates less of it than a calm one. None: every "
+        "braking regenerates (the paper's model; FASTSim's Zoe).",
+    )
     max_regen_power_w: float | None = Field(
-        None, gt=0, le=1_000_000, description="Cap on regenerated electric power [W]; none if null."
+        None,
+        ge=1,
+        le=1_000_000,
+        description="Cap on regenerated electric power [W]; none if null; at least 1 W.",
     )
     max_motor_power_w: float | None = Field(
         None,
-        gt=0,
+        ge=1000,
         le=1_000_000,
         description="Cap on the drive's mechanical power at the wheels [W]; none if null (the "
-        "paper's model). A trace that asks for more is followed as closely as the cap allows: "
-        "the van falls behind and catches up, so no energy is lost or invented.",
+        "paper's model). A trace that asks for more is driven as the cap allows: the van "
+        "accelerates and climbs more slowly and the leg takes longer (the plan's times follow); "
+        "the energy is delivered later, never dropped. At least 1 kW: less would not move a van.",
     )
     max_acceleration_mps2: float = Field(
         2.0,
@@ -63,7 +84,11 @@ class VehicleParams(Params):
         description="Maximum acceleration v̇_max [m/s²] (§2.2); 2.0 ≈ 0–100 km/h in 14 s.",
     )
     air_density_kg_m3: float = Field(
-        1.2, gt=0, le=2, description="Air density ρ for drag [kg/m³] (eq. 3); 1.2 at 20 °C."
+        1.2,
+        ge=0.5,
+        le=2,
+        description="Air density ρ for drag [kg/m³] (eq. 3); 1.2 at 20 °C; at least 0.5 kg/m³ (the "
+        "air at 5,500 m).",
     )
     auxiliaries_power_w: float = Field(
         400.0,
@@ -88,19 +113,19 @@ class VehicleParams(Params):
     )
     cab_recovery_energy_j_k: float = Field(
         60_000.0,
-        gt=0,
+        ge=1000,
         le=1_000_000,
         description="Electric energy to move the cab's temperature by one kelvin [J/K]: its "
         "thermal mass (air ≈ 4 kJ/K plus seats, dashboard and trim) over a heater efficiency of "
         "1. With the Table 2 power it sets how fast a parked cab drifts (time constant = this "
-        "value × |20 °C − outside| / Table 2 power).",
+        "value × |20 °C − outside| / Table 2 power); at least 1 kJ/K.",
     )
     cab_hvac_max_power_w: float = Field(
         6000.0,
-        gt=0,
+        ge=100,
         le=50_000,
         description="Most electric power of the cab HVAC [W]: how fast it brings the cab back "
-        "after a stop or a departure with a cold or hot cab.",
+        "after a stop or a departure with a cold or hot cab; at least 100 W.",
     )
 
 
@@ -110,22 +135,29 @@ class CargoBoxParams(Params):
     volume_m3: float = Field(8.0, ge=0.1, le=100, description="Inner volume V [m³] (Table 1).")
     wall_heat_transfer_w_m2k: float = Field(
         2.172,
-        gt=0,
+        ge=0.01,
         le=20,
-        description="Wall heat-transfer coefficient α [W/(m²·K)] (Table 1, eq. 11).",
+        description="Wall heat-transfer coefficient α [W/(m²·K)] (Table 1, eq. 11); at least 0.01 "
+        "W/(m²·K), far below the best vacuum-panel boxes.",
     )
-    roof_area_m2: float = Field(8.0, gt=0, le=100, description="Roof area A_r [m²] (Table 1).")
+    roof_area_m2: float = Field(
+        8.0, ge=0.01, le=100, description="Roof area A_r [m²] (Table 1); at least 0.01 m²."
+    )
     side_area_m2: float = Field(
-        4.182, gt=0, le=100, description="Area of one side wall A_s [m²] (Table 1)."
+        4.182,
+        ge=0.01,
+        le=100,
+        description="Area of one side wall A_s [m²] (Table 1); at least 0.01 m².",
     )
     back_area_m2: float = Field(
-        3.12, gt=0, le=100, description="Back wall area A_b [m²] (Table 1)."
+        3.12, ge=0.01, le=100, description="Back wall area A_b [m²] (Table 1); at least 0.01 m²."
     )
     wall_area_m2: float | None = Field(
         None,
-        gt=0,
+        ge=0.1,
         le=500,
-        description="Total heat-transfer area A [m²] (eq. 11); null means 2·(A_r + A_s + A_b).",
+        description="Total heat-transfer area A [m²] (eq. 11); null means 2·(A_r + A_s + A_b); at "
+        "least 0.1 m².",
     )
     setpoint_c: float = Field(
         4.0, ge=-40, le=25, description="Cargo-air set-point ϑ_CB [°C]; 4 °C for chilled goods."
@@ -168,12 +200,12 @@ class CargoBoxParams(Params):
     )
     structure_heat_capacity_j_k: float = Field(
         190_000.0,
-        gt=0,
+        ge=1000,
         le=10_000_000,
         description="Heat capacity of the box structure that follows the cargo air [J/K]: the "
         "inner GRP liner (2 mm, 1850 kg/m³, 1000 J/(kg·K)) and half the polyurethane foam "
         "(80 mm, 40 kg/m³, 1500 J/(kg·K)) over the 30.6 m² of the paper's box ≈ 187 kJ/K. "
-        "Dynamic mode, and the pull-down of a box that was not pre-cooled.",
+        "Dynamic mode, and the pull-down of a box that was not pre-cooled; at least 1 kJ/K.",
     )
     solar_absorptivity: float = Field(
         0.3,
@@ -183,10 +215,11 @@ class CargoBoxParams(Params):
     )
     outside_film_coefficient_w_m2k: float = Field(
         22.7,
-        gt=0,
+        ge=1,
         le=200,
         description="Outside surface film coefficient h_o [W/(m²·K)]: the share α/h_o of the "
-        "absorbed sun that crosses the wall (sol-air method, ASHRAE Fundamentals ch. 18).",
+        "absorbed sun that crosses the wall (sol-air method, ASHRAE Fundamentals ch. 18); at least "
+        "1 W/(m²·K).",
     )
     shadow_factor: float = Field(
         0.8,
@@ -194,24 +227,29 @@ class CargoBoxParams(Params):
         le=1,
         description="Shadow factor b_sh [–] (eq. 17); 1 is full sun, 0.8 a partly shaded street.",
     )
-    door_width_m: float = Field(1.2, gt=0, le=5, description="Door opening width W [m].")
-    door_height_m: float = Field(1.5, gt=0, le=5, description="Door opening height H [m].")
+    door_width_m: float = Field(
+        1.2, ge=0.1, le=5, description="Door opening width W [m]; at least 0.1 m."
+    )
+    door_height_m: float = Field(
+        1.5, ge=0.1, le=5, description="Door opening height H [m]; at least 0.1 m."
+    )
     doorway_flow_factor: float = Field(
         0.25,
-        gt=0,
+        ge=0.01,
         le=1.5,
         description="Doorway flow factor D_f [–] of the Gosney–Olama infiltration model, "
         "calibrated so that 10 min open at 30 K costs about two hours of wall gain of an "
-        "ATP-class box (≈0.7 kWh; see core.physics.cargo).",
+        "ATP-class box (≈0.7 kWh; see core.physics.cargo); at least 0.01.",
     )
     curtain_effectiveness: float = Field(
         0.0, ge=0, lt=1, description="Effectiveness E of a door curtain [–]; strips ≈ 0.9."
     )
     cargo_specific_heat_j_kgk: float = Field(
         2300.0,
-        gt=0,
+        ge=100,
         le=10_000,
-        description="Specific heat of the cargo c_p [J/(kg·K)] (Table 1: 2.3 kJ/(kg·K)).",
+        description="Specific heat of the cargo c_p [J/(kg·K)] (Table 1: 2.3 kJ/(kg·K)); at least "
+        "100 J/(kg·K).",
     )
     mode: Literal["steady", "dynamic"] = Field(
         "steady",
@@ -220,9 +258,9 @@ class CargoBoxParams(Params):
     )
     refrigeration_capacity_w: float = Field(
         3000.0,
-        gt=0,
+        ge=10,
         le=100_000,
-        description="Cooling capacity of the unit Q_0,max [W] (dynamic mode only).",
+        description="Cooling capacity of the unit Q_0,max [W] (dynamic mode only); at least 10 W.",
     )
     product_limit_c: float = Field(
         7.0,
@@ -244,9 +282,9 @@ class CargoBoxParams(Params):
     )
     heating_capacity_w: float = Field(
         2000.0,
-        gt=0,
+        ge=10,
         le=100_000,
-        description="Most heat the box heater delivers [W] (dynamic mode only).",
+        description="Most heat the box heater delivers [W] (dynamic mode only); at least 10 W.",
     )
 
     @field_validator("product_limit_c")
@@ -274,7 +312,7 @@ class BatteryParams(Params):
     usable_capacity_kwh: float = Field(
         40.0, ge=0.1, le=2000, description="Usable battery capacity [kWh]."
     )
-    initial_soc: float = Field(1.0, gt=0, le=1, description="State of charge at departure [–].")
+    initial_soc: float = Field(1.0, ge=0.01, le=1, description="State of charge at departure [–].")
     min_soc: float = Field(
         0.1, ge=0, lt=1, description="Reserve: lowest acceptable state of charge [–]."
     )

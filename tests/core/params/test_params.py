@@ -33,7 +33,7 @@ def test_paper_generic_carries_table_1():
 @pytest.mark.parametrize(
     ("model", "field", "value", "rule"),
     [
-        (VehicleParams, "mass_kg", -1.0, "greater than 0"),
+        (VehicleParams, "mass_kg", -1.0, "greater than or equal to 100"),
         (VehicleParams, "drivetrain_efficiency", 1.2, "less than or equal to 1"),
         (VehicleParams, "drivetrain_efficiency", 0.0, "greater than or equal to 0.1"),
         (VehicleParams, "regen_efficiency", math.nan, "finite"),
