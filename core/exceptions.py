@@ -76,6 +76,11 @@ class LimitExceededError(CoreError):
     """An input is larger than the configured limit (stops, samples...)."""
 
 
+class TooMuchToWaitForError(LimitExceededError):
+    """A request that is valid but implies more work than a synchronous answer may take (the
+    simulated time of a study): it can run as a job."""
+
+
 class ServiceUnavailableError(Exception):
     """An outside service (road router, weather service) is down, too slow or answered
     garbage. Not the client's fault: the web layer answers 503 naming ``service``.

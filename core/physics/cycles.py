@@ -12,7 +12,7 @@ traffic (``ε_t → 1``) leaves no cruising between waves (stop and go), ``ε_t 
 long as a wave lasts, light traffic (``ε_t → 0``) is nearly constant speed.
 
 Each leg starts and ends at rest, with ramps at ``ε_d·v̇_max`` (a driver with ``ε_d = 0``, who
-keeps a constant speed as in the paper's Fig. 10, ramps like a calm driver), and covers its
+keeps a constant speed as in the paper's Fig. 10, ramps at :data:`LEAST_RAMP_SHARE`), and covers its
 distance exactly. The generator is deterministic: the same inputs give the same trace.
 """
 
@@ -27,7 +27,13 @@ import numpy as np
 
 from core.arrays import FloatArray
 from core.exceptions import InvalidParameterError, LimitExceededError
-from core.params import CALM_DRIVER, NEDC_DURATION_S, StreetType
+from core.params import (
+    LEAST_RAMP_SHARE,
+    MAX_TRAFFIC_DENSITY,
+    MIN_TRAFFIC_DENSITY,
+    NEDC_DURATION_S,
+    StreetType,
+)
 
 KMH = 1 / 3.6
 #: Most samples one generated leg may have (about 58 days at 1 Hz): beyond, inputs are absurd.
@@ -106,7 +112,7 @@ def generate_leg(
         )
     density = street.traffic_density if traffic_density is None else traffic_density
     accel = driver_aggressiveness * max_acceleration_mps2
-    ramp_accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2
+    ramp_accel = max(driver_aggressiveness, LEAST_RAMP_SHARE) * max_acceleration_mps2
     v_mean = street.mean_speed_mps
 
     wave_t, wave_v = _wave_breakpoints(street, accel, density, distance_m / v_mean)
@@ -156,6 +162,43 @@ def stretch_to_duration(speed_mps: FloatArray, dt_s: float, duration_s: float) -
     return stretched * (distance / total) if total > 0 else stretched
 
 
+def rest_to_rest(
+    distance_m: float, duration_s: float, accel_mps2: float, top_mps: float, dt_s: float = 1.0
+) -> FloatArray:
+    """The plainest trace that covers ``distance_m`` from rest to rest in ``duration_s`` —
+    accelerate at ``accel_mps2``, cruise, brake at ``accel_mps2`` — or, when that is too short
+    for a van that accelerates so and tops out at ``top_mps``, in the least time it can.
+
+    The cruising speed solves ``d = v·(T − v/a)``: ``v = (a·T − √(a²T² − 4·a·d))/2``; the least
+    time is ``2·√(d/a)`` (no cruise) or ``d/v_top + v_top/a``.
+
+    Parameters
+    ----------
+    distance_m, duration_s
+        The leg [m] and the time it should take [s].
+    accel_mps2, top_mps
+        The van's acceleration (and deceleration) [m/s²] and top speed [m/s].
+    """
+    least_s = fastest_s(distance_m, accel_mps2, top_mps)
+    total_s = max(duration_s, least_s)
+    a = accel_mps2
+    cruise = (a * total_s - math.sqrt(max(a * a * total_s * total_s - 4 * a * distance_m, 0.0))) / 2
+    ramp_s = cruise / a
+    times = np.array([0.0, ramp_s, total_s - ramp_s, total_s])
+    grid = np.arange(0.0, total_s + dt_s / 2, dt_s)
+    trace = np.interp(grid, times, np.array([0.0, cruise, cruise, 0.0]))
+    covered = trace_distance_m(trace, dt_s)
+    return trace * (distance_m / covered) if covered > 0 else trace
+
+
+def fastest_s(distance_m: float, accel_mps2: float, top_mps: float) -> float:
+    """The least time a van covers ``distance_m`` from rest to rest with ``accel_mps2`` and a
+    top speed of ``top_mps`` [s]."""
+    if distance_m <= top_mps * top_mps / accel_mps2:
+        return 2.0 * math.sqrt(distance_m / accel_mps2)
+    return distance_m / top_mps + top_mps / accel_mps2
+
+
 #: Spacing of the distance grid on which a road speed profile is driven [m].
 PROFILE_GRID_M = 1.0
 #: Most grid points of one driven profile (beyond, the grid coarsens).
@@ -179,7 +222,7 @@ def drive_profile(
     slow-downs come on top: the trapezoid wave of ``street`` (paper §2.2; spaced along the road
     at the leg's mean speed, denser with more traffic, ramps set by the driver) as a factor on
     the target, capped at 1 — the router's free-flow speed is not exceeded. The van moves
-    between targets at ``max(ε_d, calm)·v̇_max``, braking ahead of slower segments and of the
+    between targets at ``max(ε_d, 0.2)·v̇_max``, braking ahead of slower segments and of the
     end: on a 1 m distance grid the speed is the lowest of every target reachable from the
     start or the end, ``v(s)² = min_j (v_j² + 2·a·|s − s_j|)``, with running minima (no loop).
     Time follows from ``ds / v``; the trace is resampled every ``dt_s`` and scaled to cover
@@ -220,7 +263,7 @@ def drive_profile(
     target = targets[segment] * np.interp(
         grid % (mean_speed * wave_t[-1]), wave_t * mean_speed, slowdown
     )
-    accel = max(driver_aggressiveness, CALM_DRIVER) * max_acceleration_mps2
+    accel = max(driver_aggressiveness, LEAST_RAMP_SHARE) * max_acceleration_mps2
     trace = _in_time(grid, _within_acceleration(grid, target, accel), dt_s)
     if trace_distance_m(trace, dt_s) == 0:  # a hop shorter than one sample: the plain ramp
         trace = generate_leg(
@@ -295,9 +338,12 @@ def _check_leg_inputs(
             f"driver_aggressiveness must be within 0..1, got {driver_aggressiveness}",
             "driver_aggressiveness",
         )
-    if traffic_density is not None and not 0 < traffic_density < 1:
+    if traffic_density is not None and not (
+        MIN_TRAFFIC_DENSITY <= traffic_density <= MAX_TRAFFIC_DENSITY
+    ):
         raise InvalidParameterError(
-            f"traffic_density must be strictly between 0 and 1, got {traffic_density}",
+            f"traffic_density must be within {MIN_TRAFFIC_DENSITY}..{MAX_TRAFFIC_DENSITY}, "
+            f"got {traffic_density}",
             "traffic_density",
         )
     if not (math.isfinite(dt_s) and dt_s > 0):

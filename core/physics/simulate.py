@@ -11,6 +11,7 @@ import datetime as dt
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -23,6 +24,7 @@ from core.physics import battery as battery_model
 from core.physics.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
 from core.physics.cargo import BoxResult, precondition_energy_j, refrigeration
 from core.physics.cycles import trace_distance_m
+from core.physics.motor import power_limited
 from core.physics.solar import (
     absorbed_solar_heat_w,
     declination_deg,
@@ -90,6 +92,8 @@ class SimulationResult:
         The extremes of every local day of the trace.
     weather_source
         Where the weather came from.
+    warnings
+        What the simulation had to change (a motor's cap the trace asked too much of).
     """
 
     time_s: FloatArray
@@ -107,6 +111,7 @@ class SimulationResult:
     weather: Weather
     weather_days: list[DayWeather]
     weather_source: WeatherSource
+    warnings: list[str]
 
 
 def _per_step(
@@ -225,19 +230,13 @@ def simulate(
     -------
     SimulationResult
     """
-    speed = check_trace(speed_mps, dt_s, min_samples=1)
-    n = speed.size
-    grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
-    payload = van.payload_kg if payload_kg is None else payload_kg
-    payload_step = _per_step(payload, n, "payload_kg", 0.0, 40_000.0)
+    trace = _driven(van, speed_mps, dt_s, grade, payload_kg, door_openings, parked, heading_deg)
+    speed, n = trace.speed, trace.speed.size
     end_s = (n - 1) * dt_s
-    _check_within(end_s, door_openings=door_openings, parked=parked)
     check_representable(start, end_s)
     time_s = np.arange(n) * dt_s
     outside = _environment(start, location, van, weather, n - 1, dt_s)
-    power, box, cab_gap_j = _consumers(
-        van, speed, dt_s, outside, grade_step, payload_step, door_openings, parked, heading_deg
-    )
+    power, box, cab_gap_j = _consumers(van, trace, dt_s, outside)
     soc, verdict, loss_j = _battery(van, power, dt_s, outside)
     grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c)
     return SimulationResult(
@@ -256,29 +255,90 @@ def simulate(
         weather=outside.first_day,
         weather_days=outside.days,
         weather_source=outside.source,
+        warnings=trace.warnings,
+    )
+
+
+@dataclass(frozen=True)
+class _Trace:
+    """The trace the van drives and what each of its steps carries."""
+
+    speed: FloatArray
+    grade_step: FloatArray | float
+    payload_step: FloatArray | float
+    heading_deg: ArrayLike | None
+    door_openings: Sequence[DoorOpening]
+    parked: Sequence[Interval]
+    warnings: list[str]
+
+
+def _driven(
+    van: VanParams,
+    speed_mps: ArrayLike,
+    dt_s: float,
+    grade: ArrayLike,
+    payload_kg: ArrayLike | None,
+    door_openings: Sequence[DoorOpening],
+    parked: Sequence[Interval],
+    heading_deg: ArrayLike | None,
+) -> _Trace:
+    """The inputs checked, and the trace the van drives: the one asked for, or — when it asks
+    for more than the motor's cap — the slower one the van can drive
+    (:func:`core.physics.motor.power_limited`), with every per-sample input and every interval
+    moved to the moment the van reaches its place."""
+    speed = check_trace(speed_mps, dt_s, min_samples=1)
+    n = speed.size
+    payload = van.payload_kg if payload_kg is None else payload_kg
+    grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
+    payload_step = _per_step(payload, n, "payload_kg", 0.0, 40_000.0)
+    _check_within((n - 1) * dt_s, door_openings=door_openings, parked=parked)
+    retimed = power_limited(
+        van.vehicle, speed, dt_s, van.vehicle.mass_kg + payload_step, grade_step
+    )
+    if retimed is None:
+        return _Trace(speed, grade_step, payload_step, heading_deg, door_openings, parked, [])
+    m = retimed.speed_mps.size
+    at = retimed.original_s / dt_s  # where each new sample lies in the original's samples
+
+    def linear(values: ArrayLike) -> ArrayLike:
+        array = np.asarray(values, dtype=float)
+        return array if array.ndim == 0 else np.interp(at, np.arange(n), array)
+
+    def stepwise(values: ArrayLike) -> ArrayLike:
+        array = np.asarray(values, dtype=float)
+        return array if array.ndim == 0 else array[np.minimum(np.floor(at).astype(int), n - 1)]
+
+    def moved(interval: Interval) -> Any:
+        return interval.model_copy(update={"start_s": float(retimed.moment_s(interval.start_s))})
+
+    cap_kw = (van.vehicle.max_motor_power_w or 0.0) / 1000
+    return _Trace(
+        retimed.speed_mps,
+        _per_step(linear(grade), m, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE),
+        _per_step(stepwise(payload), m, "payload_kg", 0.0, 40_000.0),
+        None if heading_deg is None else stepwise(heading_deg),
+        [moved(d) for d in door_openings],
+        [moved(p) for p in parked],
+        [
+            f"the motor's {cap_kw:g} kW cap cannot follow the trace: the van drives it "
+            f"{retimed.lost_s:,.0f} s slower (the same distance, the energy delivered later)"
+        ],
     )
 
 
 def _consumers(
-    van: VanParams,
-    speed: FloatArray,
-    dt_s: float,
-    outside: _Environment,
-    grade_step: FloatArray | float,
-    payload_step: FloatArray | float,
-    door_openings: Sequence[DoorOpening],
-    parked: Sequence[Interval],
-    heading_deg: ArrayLike | None,
+    van: VanParams, trace: _Trace, dt_s: float, outside: _Environment
 ) -> tuple[dict[str, FloatArray], BoxResult, float]:
     """Each consumer's power over each step [W] (:data:`CONSUMERS`), the box, and the energy a
     cab at the outside temperature needs to reach 20 °C [J]."""
+    speed = trace.speed
     n_steps = speed.size - 1
     box = refrigeration(
         van.cargo_box,
         outside.ambient_c,
         outside.solar_heat_w,
-        door_open_fraction(door_openings, np.arange(1, n_steps + 1) * dt_s, dt_s),
-        np.broadcast_to(payload_step, outside.ambient_c.shape),
+        door_open_fraction(trace.door_openings, np.arange(1, n_steps + 1) * dt_s, dt_s),
+        np.broadcast_to(trace.payload_step, outside.ambient_c.shape),
         dt_s,
         initial_c=None if van.precondition_at_depot else outside.start_c,
     )
@@ -288,12 +348,12 @@ def _consumers(
             van.vehicle,
             speed,
             dt_s,
-            van.vehicle.mass_kg + payload_step,
-            grade_step,
-            _headwind_mps(outside, heading_deg, speed.size),
+            van.vehicle.mass_kg + trace.payload_step,
+            trace.grade_step,
+            _headwind_mps(outside, trace.heading_deg, speed.size),
         ),
         "auxiliaries": auxiliaries_power_w(van.vehicle, n_steps),
-        "cabin": _cabin_power_w(van, outside, dt_s, parked, cab_gap_j),
+        "cabin": _cabin_power_w(van, outside, dt_s, trace.parked, cab_gap_j),
         "refrigeration": box.power_w,
     }
     return power, box, cab_gap_j

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core.arrays import FloatArray, reflected_cumsum
+from core.arrays import FloatArray
 from core.params import GRAVITY_MPS2, VehicleParams
 
 
@@ -94,38 +94,22 @@ def traction_force_n(
     return rolling + drag + slope_force_n(m, grade) + m * np.asarray(accel_mps2)
 
 
-def electric_power_w(vehicle: VehicleParams, mechanical_power_w: ArrayLike) -> FloatArray:
+def electric_power_w(
+    vehicle: VehicleParams, mechanical_power_w: ArrayLike, regen_floor_w: ArrayLike = -np.inf
+) -> FloatArray:
     """Battery power for a mechanical power at the wheels [W] (eq. 7, with regeneration).
 
-    Motoring (``P_mech >= 0``): ``P_el = P_mech / η_el``. Braking: ``P_el = η_regen · P_mech``
-    (negative: charges the battery), capped at ``max_regen_power_w``. The paper's eq. 7 applied
-    to braking would return more than the brakes take in, hence the separate efficiency.
+    Motoring (``P_mech >= 0``): ``P_el = P_mech / η_el``. Braking: ``P_el = η_regen ·
+    max(P_mech, floor)`` (negative: charges the battery) — the friction brakes take what lies
+    below ``regen_floor_w``, the motor's braking limit — capped at ``max_regen_power_w``. The
+    paper's eq. 7 applied to braking would return more than the brakes take in, hence the
+    separate efficiency.
     """
     p = np.asarray(mechanical_power_w, dtype=float)
-    regen = vehicle.regen_efficiency * p
+    regen = vehicle.regen_efficiency * np.maximum(p, regen_floor_w)
     if vehicle.max_regen_power_w is not None:
         regen = np.maximum(regen, -vehicle.max_regen_power_w)
     return np.where(p >= 0, p / vehicle.drivetrain_efficiency, regen)
-
-
-def motor_limited_power_w(
-    vehicle: VehicleParams, mechanical_power_w: FloatArray, dt_s: float
-) -> FloatArray:
-    """Mechanical power the motor delivers for a demanded power, capped at
-    ``max_motor_power_w`` [W].
-
-    What the cap withholds is not lost: the van falls behind the trace and the motor keeps
-    delivering its full power until it has caught up, ``b_k = max(0, b_{k−1} +
-    (P_k − P_max)·Δt)``, ``P_delivered,k = P_k − (b_k − b_{k−1})/Δt`` (vectorised with
-    :func:`core.arrays.reflected_cumsum`). The kinetic and potential energy of the trace are
-    delivered in full, a little later.
-    """
-    cap = vehicle.max_motor_power_w
-    if cap is None or mechanical_power_w.size == 0:
-        return mechanical_power_w
-    behind_j = reflected_cumsum((mechanical_power_w - cap) * dt_s)
-    caught_up_j = np.diff(behind_j, axis=-1, prepend=0.0)
-    return mechanical_power_w - caught_up_j / dt_s
 
 
 def step_traction_power_w(
@@ -137,6 +121,9 @@ def step_traction_power_w(
     headwind_mps: ArrayLike = 0.0,
 ) -> FloatArray:
     """Electric traction power of every step of a speed trace [W] (eqs 2, 6, 7).
+
+    The trace is driven as it is: a motor's cap changes the trace the van can drive
+    (:func:`core.physics.motor.power_limited`), not the power of a trace.
 
     Parameters
     ----------
@@ -157,4 +144,13 @@ def step_traction_power_w(
     v_mean = 0.5 * (v_start + v_end)
     accel = (v_end - v_start) / dt_s
     mechanical = traction_force_n(vehicle, mass_kg, v_mean, accel, grade, headwind_mps) * v_mean
-    return electric_power_w(vehicle, motor_limited_power_w(vehicle, mechanical, dt_s))
+    return electric_power_w(vehicle, mechanical, regen_floor_w(vehicle, mass_kg, v_mean))
+
+
+def regen_floor_w(vehicle: VehicleParams, mass_kg: ArrayLike, speed_mps: ArrayLike) -> FloatArray:
+    """The most braking power the motor takes at a speed [W, negative]: its braking force
+    ``m · max_regen_deceleration_mps2`` times the speed; −∞ without that limit."""
+    limit = vehicle.max_regen_deceleration_mps2
+    if limit is None:
+        return np.full(np.shape(speed_mps), -np.inf)
+    return -np.asarray(mass_kg, dtype=float) * limit * np.asarray(speed_mps, dtype=float)

@@ -7,7 +7,6 @@ from core.params import GRAVITY_MPS2, VehicleParams
 from core.physics.vehicle import (
     drag_force_n,
     electric_power_w,
-    motor_limited_power_w,
     rolling_force_n,
     slope_force_n,
     step_traction_power_w,
@@ -101,20 +100,6 @@ def test_headwind_drag_by_hand():
     assert drag_force_n(VAN, 20.0, -25.0) == pytest.approx(-0.842898 * 25, rel=1e-5)
     # standing still: no drag on the van's own power budget
     assert traction_force_n(VAN, MASS, 0.0, 0.0, 0.0, 10.0) == 0.0
-
-
-def test_motor_cap_delivers_the_same_energy_later():
-    # A hard 0 → 25 m/s launch of 2230 kg at 2 m/s² asks for up to 110 kW at the wheels;
-    # capped at 50 kW the van lags and catches up while cruising: the same mechanical energy,
-    # never more than 50 kW.
-    capped = VehicleParams(max_motor_power_w=50_000, regen_efficiency=0)
-    speed = np.concatenate((np.arange(0, 25.5, 2.0), np.full(120, 25.0)))
-    free = step_traction_power_w(VAN.model_copy(update={"regen_efficiency": 0}), speed, 1, MASS, 0)
-    limited = step_traction_power_w(capped, speed, 1, MASS, 0)
-    assert free.max() * VAN.drivetrain_efficiency > 100_000
-    assert limited.max() == pytest.approx(50_000 / VAN.drivetrain_efficiency)
-    assert limited.sum() == pytest.approx(free.sum(), rel=1e-9)
-    assert motor_limited_power_w(VAN, np.array([1e9]), 1.0) == pytest.approx([1e9])  # no cap
 
 
 def test_regen_cap_limits_charging_power():
