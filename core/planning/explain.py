@@ -56,7 +56,11 @@ def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[Unass
             rules.violations(v, [*route[:k], node, *route[k:]]) for k in range(len(route) + 1)
         ]
         refusals.update(min(options, key=len)[:1])
-    if not refusals:
-        return "shift", "the search ended (time limit) before it found a route for it"
+    if not refusals:  # every van could take it by the estimates: the search ran out of time
+        return (
+            "time_limit",
+            "the search ended at its time limit before it found a place for it on a route; a "
+            "longer time_limit_s (or a job) finds one",
+        )
     reason = _most_shared(refusals)
     return reason, _FULL_DETAIL[reason]

@@ -49,7 +49,7 @@ from core.planning.model import (
 from core.planning.repair import Repaired, fitting, repair
 from core.planning.scene import Scene, legs_for
 from core.planning.solver_input import routing_input
-from core.planning.timeline import drive_time_s
+from core.planning.timeline import client_legs_too_fast, drive_time_s
 from core.planning.verify import Failure, route_failure, traced_seconds
 from core.routing.geo import build_legs
 from core.routing.roads import RememberingRouter, RoadRouter
@@ -97,7 +97,15 @@ def plan_fleet(
         first,
         last.timestamp() - first.timestamp() + 2 * 3600.0,
     )
-    scene = Scene(problem.places, legs, timezone_name, lambda _begin, _span_s: day_weather)
+    fastest = max(v.van.vehicle.max_acceleration_mps2 for v in problem.vehicles)
+    too_fast = client_legs_too_fast(legs, fastest)
+    scene = Scene(
+        problem.places,
+        legs,
+        timezone_name,
+        lambda _begin, _span_s: day_weather,
+        (too_fast,) if too_fast else (),
+    )
     remembering = None if router is None else RememberingRouter(router)
     routed = search(
         fleet_day(shifts, scene, remembering),

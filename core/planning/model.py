@@ -24,6 +24,7 @@ from core.params import (
     RoadMatrix,
     Stop,
     StreetTypeName,
+    TrafficDensity,
     VanParams,
     Weather,
     clock_field,
@@ -74,8 +75,8 @@ class RoundFields(Params):
     driver_aggressiveness: float = Field(
         NORMAL_DRIVER, ge=0, le=1, description="ε_d [–]: 0.2 calm, 0.5 normal, 1 aggressive."
     )
-    traffic_density: float | None = Field(
-        None, gt=0, lt=1, description="ε_t [–]; absent: the street type's default."
+    traffic_density: TrafficDensity | None = Field(
+        None, description="ε_t [–], 0.01–0.99; absent: the street type's default."
     )
     objective: Objective = Field("distance", description="What the tour minimises.")
     matrix: RoadMatrix | None = Field(
@@ -286,7 +287,9 @@ class PlanResult:
     late_stops: list[str]
 
 
-UnassignedReason = Literal["time_window", "capacity", "battery", "shift", "unreachable"]
+UnassignedReason = Literal[
+    "time_window", "capacity", "battery", "shift", "unreachable", "time_limit"
+]
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ from core.planning.model import (
     check_stop_ids,
 )
 from core.planning.scene import Scene, legs_for, weather_service_for
-from core.planning.timeline import windows_after
+from core.planning.timeline import client_legs_too_fast, windows_after
 from core.planning.verify import simulate_route
 from core.routing.geo import Legs, build_legs
 from core.routing.roads import RememberingRouter, RoadRouter
@@ -60,8 +60,13 @@ def plan(
     start, timezone_name = check(problem)
     legs = legs_for(problem, router)
     _check_reachable(problem, legs)
+    too_fast = client_legs_too_fast(legs, problem.van.vehicle.max_acceleration_mps2)
     scene = Scene(
-        problem.places, legs, timezone_name, weather_service_for(problem, weather_service)
+        problem.places,
+        legs,
+        timezone_name,
+        weather_service_for(problem, weather_service),
+        (too_fast,) if too_fast else (),
     )
     windowed = any(stop.time_windows for stop in problem.stops)
     if windowed and not problem.keep_order:

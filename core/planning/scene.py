@@ -20,12 +20,13 @@ WeatherFor = Callable[[dt.datetime, float], tuple[Forecast | None, list[str]]]
 @dataclass(frozen=True)
 class Scene:
     """The places (the depot, then the stops), every ordered pair's leg, the zone's name for
-    the answers and the weather of a day."""
+    the answers, the weather of a day, and what every answer of it should warn of."""
 
     places: list[Depot]
     legs: Legs
     timezone_name: str
     weather_for: WeatherFor
+    notes: tuple[str, ...] = ()
 
 
 def legs_for(problem: RoundFields, router: RoadRouter | None) -> Legs:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from pydantic import Field
 
-from core.exceptions import CoreError, InvalidParameterError
+from core.exceptions import CoreError, InvalidParameterError, TooMuchToWaitForError
 from core.params import (
     AGGRESSIVE_DRIVER,
     CALM_DRIVER,
@@ -26,7 +26,7 @@ from core.params import (
     Weather,
 )
 from core.physics.cycles import generate_leg
-from core.physics.simulate import CONSUMERS, simulate
+from core.physics.simulate import CONSUMERS, MAX_SPEED_MPS, simulate
 from core.physics.weather import WeatherService
 from core.planning.model import PlanProblem, PlanResult
 from core.planning.round import plan
@@ -108,6 +108,13 @@ def speed_sweep(
             van.vehicle.max_acceleration_mps2,
             traffic_density,
         )
+        if trace.max() > MAX_SPEED_MPS:
+            raise InvalidParameterError(
+                f"speeds_kmh[{index}] = {speed_kmh:g} km/h: with this driver the speed swings "
+                f"to {trace.max() * 3.6:.0f} km/h, above the {MAX_SPEED_MPS * 3.6:.0f} km/h the "
+                "service simulates; sweep a lower speed or a calmer driver",
+                f"speeds_kmh[{index}]",
+            )
         result = simulate(trace, 1.0, start, location, van, weather=weather)
         per_km = {k: v * 1e6 / result.distance_m for k, v in result.energy_kwh.items()}
         points.append(SpeedPoint(speed_kmh, per_km))
@@ -164,6 +171,7 @@ def scenario_grid(
     progress: Callable[[int, int], None] | None = None,
     router: RoadRouter | None = None,
     weather_service: WeatherService | None = None,
+    max_simulated_s: float | None = None,
 ) -> ScenarioGrid:
     """The round of ``problem`` over every combination of season, driver and traffic.
 
@@ -177,7 +185,7 @@ def scenario_grid(
     problem
         The round and its baseline conditions.
     seasons, drivers, traffic
-        The axes; None takes winter/summer, calm/normal/aggressive (ε_d 0.2, 0.5, 1.0) and
+        The axes; None takes winter/summer, calm/normal/aggressive (ε_d 0.3, 0.5, 1.0) and
         light/heavy traffic (ε_t 0.2, 0.8).
     progress
         Called with (cells done, cells in all) after each cell.
@@ -185,6 +193,9 @@ def scenario_grid(
         As for :func:`core.planning.round.plan`; the router is asked once per leg for the
         whole grid. A season with its own weather keeps it; the others get the service's
         forecast.
+    max_simulated_s
+        Most time the cells may simulate together [s] (the baseline round's duration times
+        the cells); beyond, :class:`core.exceptions.TooMuchToWaitForError`. None: no bound.
     """
     seasons = list(seasons) if seasons is not None else default_seasons(problem.date.year)
     drivers = list(drivers) if drivers is not None else list(DEFAULT_DRIVERS)
@@ -198,6 +209,16 @@ def scenario_grid(
             raise InvalidParameterError(f"{name} must hold at least one value", name)
     remembering = None if router is None else RememberingRouter(router)
     baseline = plan(problem, remembering, weather_service)
+    n_cells = len(seasons) * len(drivers) * len(traffic)
+    cells_s = baseline.duration_s * n_cells
+    if max_simulated_s is not None and cells_s > max_simulated_s:
+        raise TooMuchToWaitForError(
+            f"{n_cells} cells of a {baseline.duration_s / 3600:,.1f} h round simulate "
+            f"{cells_s / 86_400:,.0f} days; a synchronous study simulates at most "
+            f"{max_simulated_s / 86_400:,.0f}: fewer cells, or submit it as a job "
+            "(POST /v1/jobs, type scenarios)",
+            "seasons",
+        )
     by_id = {stop.id: stop for stop in problem.stops}
     fixed = problem.model_copy(
         update={

@@ -20,7 +20,16 @@ from numpy.typing import NDArray
 
 from core.arrays import FloatArray
 from core.params import STREET_TYPES, Depot, DoorOpening, Interval, Stop, StreetTypeName
-from core.physics.cycles import drive_profile, generate_leg, stretch_to_duration
+from core.physics.cycles import (
+    drive_profile,
+    fastest_s,
+    generate_leg,
+    rest_to_rest,
+    stretch_to_duration,
+    trace_distance_m,
+)
+from core.physics.motor import power_limited
+from core.physics.simulate import MAX_SPEED_MPS
 from core.planning.model import PlanProblem
 from core.routing.geo import STREET_TYPE_NAMES, Legs, street_type_by_speed
 from core.routing.roads import LegRoute, bearing_deg
@@ -56,6 +65,17 @@ def windows_after(
     ]
 
 
+@dataclass(frozen=True)
+class Drive:
+    """One leg as the van drives it: speed every :data:`PLAN_DT_S` [m/s], the heading of each
+    sample [°], the street type, and how much longer the motor's cap made it [s]."""
+
+    speed_mps: FloatArray
+    heading_deg: FloatArray
+    street_type: StreetTypeName
+    capped_s: float = 0.0
+
+
 def drive(
     problem: PlanProblem,
     legs: Legs,
@@ -63,11 +83,14 @@ def drive(
     j: int,
     route: LegRoute | None,
     straight_heading_deg: float = 0.0,
-) -> tuple[FloatArray, FloatArray, StreetTypeName]:
-    """Speed trace [m/s, every :data:`PLAN_DT_S`], heading of each sample [°] and street type
-    of the leg from place i to place j: the road's speed profile from a router, or the paper's
-    trace for the leg's street type (stretched to the client's duration for a client matrix)."""
+    payload_kg: float | None = None,
+) -> Drive:
+    """The leg from place i to place j: the road's speed profile from a router, or the paper's
+    trace for the leg's street type (stretched to the client's duration for a client matrix),
+    driven as the van's motor allows (:func:`core.physics.motor.power_limited`, at the van's
+    mass with ``payload_kg``, the departure payload if None)."""
     vehicle = problem.van.vehicle
+    mass_kg = vehicle.mass_kg + (problem.van.payload_kg if payload_kg is None else payload_kg)
     if route is None:
         street_type = legs.street_type_name(i, j)
         trace = generate_leg(
@@ -79,11 +102,15 @@ def drive(
             PLAN_DT_S,
         )
         if legs.source == "client":  # the client's router knows how long the leg takes
-            trace = stretch_to_duration(trace, PLAN_DT_S, float(legs.duration_s[i, j]))
-        return trace, np.full(trace.size, straight_heading_deg), street_type
+            trace = _in_the_clients_time(vehicle.max_acceleration_mps2, trace, legs, i, j)
+        driven = power_limited(vehicle, trace, PLAN_DT_S, mass_kg, float(legs.grade[i, j]))
+        if driven is None:
+            return Drive(trace, np.full(trace.size, straight_heading_deg), street_type)
+        speed = driven.speed_mps
+        return Drive(speed, np.full(speed.size, straight_heading_deg), street_type, driven.lost_s)
     free_flow_s = float(np.sum(route.segment_distance_m / route.segment_speed_mps))
     street_type = STREET_TYPE_NAMES[int(street_type_by_speed(route.distance_m, free_flow_s))]
-    trace, travelled = drive_profile(
+    trace, _ = drive_profile(
         route.segment_distance_m,
         route.segment_speed_mps,
         STREET_TYPES[street_type],
@@ -92,23 +119,72 @@ def drive(
         problem.traffic_density,
         PLAN_DT_S,
     )
+    driven = power_limited(vehicle, trace, PLAN_DT_S, mass_kg, float(legs.grade[i, j]))
+    speed = trace if driven is None else driven.speed_mps
+    travelled = np.concatenate(([0.0], np.cumsum(0.5 * (speed[:-1] + speed[1:]) * PLAN_DT_S)))
     ends = np.cumsum(route.segment_distance_m)
     segment = np.minimum(np.searchsorted(ends, travelled), ends.size - 1)
-    return trace, route.segment_heading_deg[segment], street_type
+    lost_s = 0.0 if driven is None else driven.lost_s
+    return Drive(speed, route.segment_heading_deg[segment], street_type, lost_s)
+
+
+def _in_the_clients_time(
+    accel_mps2: float, trace: FloatArray, legs: Legs, i: int, j: int
+) -> FloatArray:
+    """A generated leg stretched to the client's duration; where that asks more than the van's
+    acceleration or top speed, the plainest trace that lasts as long (or, for a duration no
+    van can drive from rest to rest, as short as the van can: :func:`client_legs_too_fast`
+    says so in the answer)."""
+    distance_m, duration_s = float(legs.distance_m[i, j]), float(legs.duration_s[i, j])
+    stretched = stretch_to_duration(trace, PLAN_DT_S, duration_s)
+    steepest = float(np.abs(np.diff(stretched)).max()) / PLAN_DT_S if stretched.size > 1 else 0.0
+    covered = trace_distance_m(stretched, PLAN_DT_S)
+    if (
+        stretched.max() <= MAX_SPEED_MPS
+        and steepest <= accel_mps2 * (1 + 1e-9)
+        and covered >= distance_m * (1 - 1e-9)
+    ):
+        return stretched
+    return rest_to_rest(distance_m, duration_s, accel_mps2, MAX_SPEED_MPS, PLAN_DT_S)
+
+
+def client_legs_too_fast(legs: Legs, accel_mps2: float) -> str | None:
+    """A warning when the client's matrix gives legs less time than a van with this
+    acceleration needs from rest to rest at 250 km/h at most (those legs take what it needs),
+    naming the first such cell; None when every leg can be driven in its time."""
+    if legs.source != "client":
+        return None
+    n = legs.distance_m.shape[0]
+    short = [
+        (i, j, fastest_s(float(legs.distance_m[i, j]), accel_mps2, MAX_SPEED_MPS))
+        for i in range(n)
+        for j in range(n)
+        if i != j and legs.distance_m[i, j] > 0
+    ]
+    short = [(i, j, least) for i, j, least in short if legs.duration_s[i, j] < least - 1e-9]
+    if not short:
+        return None
+    i, j, least = short[0]
+    return (
+        f"matrix.durations_s[{i}][{j}]: {legs.duration_s[i, j]:g} s for "
+        f"{legs.distance_m[i, j]:g} m is faster than a van can drive from rest to rest (at least "
+        f"{least:.1f} s); {len(short)} such leg{'s' if len(short) > 1 else ''} of the matrix take "
+        "what the van needs"
+    )
 
 
 def drive_time_s(problem: PlanProblem, legs: Legs, i: int, j: int, route: LegRoute | None) -> float:
     """How long the van takes from place i to place j in the simulation [s] (the generated or
     road-profile trace, which may differ from the matrix's duration)."""
-    trace, _, _ = drive(problem, legs, i, j, route)
-    return (trace.size - 1) * PLAN_DT_S
+    return (drive(problem, legs, i, j, route).speed_mps.size - 1) * PLAN_DT_S
 
 
 @dataclass(frozen=True)
 class Timeline:
     """The day sample by sample, and the marks that split it: leg k drives from depart[k] to
     arrive[k]; the stop after it (if any) waits for its window until serve[k] and lasts until
-    leave[k]; ``late`` lists the places reached after their last window closed."""
+    leave[k]; ``late`` lists the places reached after their last window closed; ``capped_s``
+    is how much longer the motor's cap made the drives [s]."""
 
     speed: FloatArray
     grade: FloatArray
@@ -123,6 +199,7 @@ class Timeline:
     late: list[int]
     street_types: list[StreetTypeName]
     geometry: list[list[tuple[float, float]]]
+    capped_s: float = 0.0
 
     @property
     def duration_s(self) -> float:
@@ -148,6 +225,7 @@ class _Builder:
     late: list[int] = field(default_factory=list)
     street_types: list[StreetTypeName] = field(default_factory=list)
     geometry: list[list[tuple[float, float]]] = field(default_factory=list)
+    capped_s: float = 0.0
 
     def __post_init__(self) -> None:
         self.payload.append(np.array([self.payload_kg]))
@@ -207,6 +285,7 @@ class _Builder:
             late=self.late,
             street_types=self.street_types,
             geometry=self.geometry,
+            capped_s=self.capped_s,
         )
 
 
@@ -227,16 +306,17 @@ def build_timeline(
     for k, (i, j) in enumerate(itertools.pairwise(order)):
         a, b = places[i], places[j]
         route = routes[k] if routes is not None else None
-        trace, heading, street_type = drive(
-            problem, legs, i, j, route, bearing_deg(a.lat, a.lon, b.lat, b.lon)
+        leg = drive(
+            problem, legs, i, j, route, bearing_deg(a.lat, a.lon, b.lat, b.lon), day.payload_kg
         )
-        day.street_types.append(street_type)
+        day.street_types.append(leg.street_type)
+        day.capped_s += leg.capped_s
         day.geometry.append(
             [(float(x), float(y)) for x, y in route.coordinates]
             if route is not None
             else [(a.lon, a.lat), (b.lon, b.lat)]
         )
-        day.drive(trace, heading, float(legs.grade[i, j]))
+        day.drive(leg.speed_mps, leg.heading_deg, float(legs.grade[i, j]))
         if j != 0:
             day.serve(j, problem.stops[j - 1], windows_s[j] if windows_s is not None else ())
         else:

@@ -84,6 +84,13 @@ def simulate_route(
             timeline = build_timeline(problem, scene.places, scene.legs, order, roads, windows_s)
     check_representable(start, timeline.duration_s, "date")
     weather, warnings = scene.weather_for(start, timeline.duration_s)
+    if timeline.capped_s > 0:
+        cap_kw = (problem.van.vehicle.max_motor_power_w or 0.0) / 1000
+        warnings = [
+            *warnings,
+            f"the motor's {cap_kw:g} kW cap makes the van slower than the traffic: the drives "
+            f"take {timeline.capped_s / 60:,.1f} min longer in all (the times include it)",
+        ]
     result = simulate(
         timeline.speed,
         PLAN_DT_S,
@@ -219,7 +226,7 @@ class _Split:
             weather=simulated.weather,
             weather_days=simulated.weather_days,
             weather_source=simulated.weather_source,
-            warnings=warnings,
+            warnings=[*warnings, *simulated.warnings, *self.scene.notes],
             timezone=self.scene.timezone_name,
             distance_source=legs.source,
             depot_snap_distance_m=None if snap is None else float(snap[0]),
