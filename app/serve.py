@@ -21,8 +21,9 @@ def main() -> None:
         host=settings.host,
         port=settings.port,
         log_level=settings.log_level,
-        # The app writes one JSON line per request itself.
+        # The app writes one JSON line per request itself, and every other line as JSON too.
         access_log=False,
+        log_config=None,
         # uvicorn's own wait comes after the app's grace, so late requests still get their 503.
         timeout_graceful_shutdown=math.ceil(settings.shutdown_grace_s) + 1,
     )
