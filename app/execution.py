@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import ctypes
 import multiprocessing
 import os
 import signal
@@ -33,6 +34,7 @@ from typing import Any, TypeVar
 
 from pebble import ProcessExpired, ProcessPool
 
+from app.logs import configure_logging
 from app.settings import Settings
 from core.arrays import keep_heap
 
@@ -60,22 +62,39 @@ class UnavailableError(Exception):
         self.retry_after_s = retry_after_s
 
 
+#: ``PR_SET_PDEATHSIG`` of Linux's ``prctl`` (linux/prctl.h).
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent(parent_pid: int) -> None:
+    """Have the kernel kill this worker when the process that started it dies, even by SIGKILL
+    and in the middle of a C++ search that holds the GIL; where the kernel cannot (not Linux),
+    a thread that watches the parent (it may lag behind a search that holds the GIL)."""
+    with contextlib.suppress(AttributeError, OSError):
+        if ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL) == 0:
+            if os.getppid() != parent_pid:  # the parent died before the request took effect
+                os._exit(1)
+            return
+    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True).start()
+
+
 def _watch_parent(parent_pid: int) -> None:
-    """Exit when the server that started this worker is gone (even after SIGKILL)."""
+    """Exit when the server that started this worker is gone."""
     while True:
         time.sleep(1.0)
         if os.getppid() != parent_pid:
             os._exit(1)
 
 
-def _initialize_worker(parent_pid: int) -> None:
+def _initialize_worker(parent_pid: int, log_level: str) -> None:
     keep_heap()
+    configure_logging(log_level)
     with contextlib.suppress(OSError):  # not permitted: keep the default priority
         os.nice(WORKER_NICENESS)
     # Stopping a worker must be instant even inside OR-Tools' C++ search (a Python-level
     # handler would only run when the search returns): the operating system's default.
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True).start()
+    _die_with_parent(parent_pid)
 
 
 def ping() -> int:
@@ -92,8 +111,9 @@ class WorkerPool:
         How many processes.
     """
 
-    def __init__(self, workers: int) -> None:
+    def __init__(self, workers: int, log_level: str = "info") -> None:
         self.workers = workers
+        self.log_level = log_level
         self._pool: ProcessPool | None = None
 
     @property
@@ -103,7 +123,7 @@ class WorkerPool:
                 max_workers=self.workers,
                 context=multiprocessing.get_context("spawn"),
                 initializer=_initialize_worker,
-                initargs=(os.getpid(),),
+                initargs=(os.getpid(), self.log_level),
             )
         return self._pool
 
@@ -147,7 +167,7 @@ class Executor:
         self._underway: set[Future[Any]] = set()
         self._stopped = False
         self._draining: asyncio.Task[None] | None = None
-        self.pool = WorkerPool(settings.workers)
+        self.pool = WorkerPool(settings.workers, settings.log_level)
 
     def _slots(self) -> asyncio.Semaphore:
         if self._free is None:
@@ -156,8 +176,10 @@ class Executor:
 
     async def warm_up(self) -> None:
         """Start every worker and have it import the work (``load``'s module; about 2 s,
-        once)."""
-        await asyncio.to_thread(self.pool.warm, self.load)
+        once). Scheduled from the event loop's thread: the kernel ties each worker's life to
+        the thread that started it, and this one lives as long as the server."""
+        futures = [self.pool.schedule(self.load, ()) for _ in range(self.settings.workers)]
+        await asyncio.gather(*(asyncio.wrap_future(future) for future in futures))
 
     def alive(self) -> bool:
         """Whether the pool runs and takes work."""

@@ -53,7 +53,15 @@ def _celery(broker_url: str, queue: str, visibility_s: int) -> Celery:
         task_ignore_result=True,
         broker_connection_retry_on_startup=True,
         worker_hijack_root_logger=False,
-        broker_transport_options={"visibility_timeout": visibility_s},
+        # A broker that is down fails a send at once (the job is stored; the dispatcher sends
+        # it when the broker is back): a client's POST never waits on it.
+        task_publish_retry=False,
+        broker_connection_timeout=2,
+        broker_transport_options={
+            "visibility_timeout": visibility_s,
+            "socket_connect_timeout": 2,
+            "socket_timeout": 5,
+        },
     )
     app.task(bind=True, name=TASK)(_run_job)
     return app
@@ -62,7 +70,7 @@ def _celery(broker_url: str, queue: str, visibility_s: int) -> Celery:
 @lru_cache(maxsize=1)
 def _pool(workers: int) -> WorkerPool:
     """This worker's process pool (one per Celery worker process)."""
-    return WorkerPool(workers)
+    return WorkerPool(workers, get_settings().log_level)
 
 
 def _run_job(task: Task, job_id: str) -> str:

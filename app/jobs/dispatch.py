@@ -1,6 +1,10 @@
 """The servers' side of the Celery scale-out: hand queued jobs to the workers and keep the
-queue honest — jobs the broker never got (or lost: Redis keeps nothing on disk) are sent again,
-retries when their backoff is over, jobs whose worker died are queued again."""
+queue honest. A job is stored before it is sent, so a broker that is down loses nothing: the
+job is sent when the broker is back (within a sweep). Retries are sent when their backoff is
+over, one message per attempt. A broker that restarted (Redis keeps nothing on disk) lost every
+message it held: those jobs are sent again at once. A message can also vanish with a worker
+that died holding it; a job sent long ago that has not started is sent again only when the
+queue is empty — a backlog is messages waiting for workers, not lost ones."""
 
 from __future__ import annotations
 
@@ -8,6 +12,7 @@ import asyncio
 import contextlib
 import logging
 import uuid
+from typing import Literal
 
 from app.jobs.celery_app import TASK, celery_for
 from app.jobs.lifecycle import SWEEP_EVERY_S, Lifecycle, runner_name
@@ -26,6 +31,7 @@ class CeleryDispatcher:
         self.lifecycle = Lifecycle(store, settings, runner_name())
         self.celery = celery_for(settings)
         self._task: asyncio.Task[None] | None = None
+        self._broker_run: str | None = None  # the broker's run id: it changes when it restarts
 
     def start(self) -> None:
         self._task = asyncio.create_task(self._loop())
@@ -42,8 +48,11 @@ class CeleryDispatcher:
         return max(10 * self.settings.job_stale_after_s, 120.0)
 
     async def submitted(self, job: JobView) -> None:
-        """A job was queued: send it now."""
-        await asyncio.to_thread(self.dispatch, job.id)
+        """A job was queued: send it now, or — the broker being down — when it is back."""
+        try:
+            await asyncio.to_thread(self.dispatch, job.id)
+        except Exception as error:  # stored: the sweep sends it
+            _log.warning("broker unavailable (%s); job %s is sent when it is back", error, job.id)
 
     def dispatch(self, job_id: str) -> None:
         """Send one attempt of a job to the workers, unless another dispatcher just did."""
@@ -57,10 +66,33 @@ class CeleryDispatcher:
 
     def _sweep(self) -> None:
         self.lifecycle.sweep()
-        # Jobs the broker never got (a crash between storing and sending), retries now due,
-        # and messages lost (Redis restarted) once they have waited well past a normal start.
-        for job in self.store.undispatched(older_than_s=self.resend_after_s):
+        broker = self._broker()
+        if isinstance(broker, tuple):
+            run, waiting = broker
+            if self._broker_run is not None and run != self._broker_run:
+                lost = self.store.forget_dispatches()
+                _log.warning("the broker restarted: %d queued jobs are sent again", lost)
+            self._broker_run = run
+            resend = waiting == 0
+        else:  # "other": a broker that cannot say what it holds; "down": nothing goes out now
+            resend = broker == "other"
+        # Never sent (the broker was down, or a crash between storing and sending) and due; and,
+        # with nothing waiting in the queue, sent long ago without starting.
+        for job in self.store.undispatched(self.resend_after_s if resend else None):
             self.dispatch(job.id)
+
+    def _broker(self) -> tuple[str, int] | Literal["other", "down"]:
+        """The broker's run id and the messages waiting in the queue (Redis); "other" for a
+        broker that cannot tell, "down" when it does not answer."""
+        try:
+            with self.celery.connection_for_write() as connection:
+                client = connection.default_channel.client
+                run = str(client.info("server")["run_id"])
+                return run, int(client.llen(self.settings.broker_queue))
+        except AttributeError:  # not a Redis broker
+            return "other"
+        except Exception:
+            return "down"
 
     async def _loop(self) -> None:
         while True:

@@ -315,18 +315,26 @@ class JobStore:
             query = select(Job).where(Job.status == "running", Job.heartbeat_at < silent_since)
             return [JobView.of(job) for job in session.scalars(query)]
 
-    def undispatched(self, older_than_s: float) -> list[JobView]:
-        """Queued jobs that are due and were not handed to the broker (or were handed long ago
-        and have not started)."""
+    def undispatched(self, resend_after_s: float | None) -> list[JobView]:
+        """Queued jobs that are due and were not handed to the broker — or, with
+        ``resend_after_s``, were handed that long ago and have not started."""
         moment = now()
-        before = moment - dt.timedelta(seconds=older_than_s)
+        sent: ColumnElement[bool] = Job.dispatched_at.is_(None)
+        if resend_after_s is not None:
+            sent = sent | (Job.dispatched_at < moment - dt.timedelta(seconds=resend_after_s))
         with self._transaction() as session:
-            query = select(Job).where(
-                Job.status == "queued",
-                _due(moment),
-                (Job.dispatched_at.is_(None)) | (Job.dispatched_at < before),
-            )
+            query = select(Job).where(Job.status == "queued", _due(moment), sent)
             return [JobView.of(job) for job in session.scalars(query)]
+
+    def forget_dispatches(self) -> int:
+        """The broker lost its messages: every queued job counts as never sent; how many."""
+        with self._transaction() as session:
+            done = session.execute(
+                update(Job)
+                .where(Job.status == "queued", Job.dispatched_at.is_not(None))
+                .values(dispatched_at=None)
+            )
+            return int(done.rowcount)  # type: ignore[attr-defined]
 
     def take_dispatch(self, job_id: str, resend_after_s: float) -> bool:
         """Whether this caller is to send the job to the broker now: it is queued and due, and

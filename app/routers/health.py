@@ -80,7 +80,23 @@ async def readiness(
                 connection.ensure_connection(max_retries=1, timeout=CHECK_TIMEOUT_S)
             return "the broker answers"
 
+        def celery_workers() -> str:
+            queue = settings.broker_queue
+            answers = celery_for(settings).control.inspect(timeout=1.0).active_queues() or {}
+            serving = sorted(
+                worker
+                for worker, queues in answers.items()
+                if any(q.get("name") == queue for q in queues or [])
+            )
+            if not serving:
+                raise RuntimeError(
+                    f"no Celery worker takes jobs from queue {queue!r} "
+                    f"({len(answers)} other workers answer): jobs would wait; start `make worker`"
+                )
+            return f"{len(serving)} Celery workers take jobs from {queue!r}: {', '.join(serving)}"
+
         checks.append(_check("broker", broker))
+        checks.append(_check("celery_workers", celery_workers))
     if settings.osrm_url is not None:
         checks.append(
             _check("osrm", _http_probe(f"{settings.osrm_url.rstrip('/')}/nearest/v1/driving/0,0"))
