@@ -35,10 +35,12 @@ def require_api_key(settings: SettingsDep, request: Request) -> None:
     is a security scheme in the OpenAPI document (app.openapi_doc), not a parameter."""
     if settings.api_key is None:
         return
-    x_api_key = request.headers.get("x-api-key")
+    sent = request.headers.getlist("x-api-key")
     expected = settings.api_key.get_secret_value().encode()
-    # Bytes: compare_digest refuses non-ASCII text, and any key a client sends is just wrong.
-    if x_api_key is None or not secrets.compare_digest(x_api_key.encode(), expected):
+    # Bytes: compare_digest refuses non-ASCII text, and any key a client sends is just wrong. A
+    # repeated header is refused whatever its values: one server may read the first, a proxy
+    # the last.
+    if len(sent) != 1 or not secrets.compare_digest(sent[0].encode(), expected):
         raise HTTPException(
-            401, "missing or wrong X-API-Key", headers={"WWW-Authenticate": "ApiKey"}
+            401, "missing, repeated or wrong X-API-Key", headers={"WWW-Authenticate": "ApiKey"}
         )

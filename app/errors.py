@@ -13,7 +13,12 @@ from sqlalchemy.exc import OperationalError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from app.execution import UnavailableError
-from core.exceptions import CoreError, LimitExceededError, ServiceUnavailableError
+from core.exceptions import (
+    CoreError,
+    LimitExceededError,
+    ServiceUnavailableError,
+    TooMuchToWaitForError,
+)
 
 PROBLEM_JSON = "application/problem+json"
 E = TypeVar("E", bound=Exception)
@@ -45,17 +50,37 @@ def problem(
 
 def core_problem(error: CoreError) -> dict[str, Any]:
     """The 422 problem of a core error, naming its field."""
-    title = "Limit exceeded" if isinstance(error, LimitExceededError) else "Invalid request"
+    if isinstance(error, TooMuchToWaitForError):  # valid, but for a job: 413 like a large body
+        status, title = 413, "Request too large"
+    elif isinstance(error, LimitExceededError):
+        status, title = 422, "Limit exceeded"
+    else:
+        status, title = 422, "Invalid request"
     errors = [
-        {"field": field, "message": message, "type": "value_error"}
+        {
+            "field": _echo(field, MAX_ECHO_PART * 4),
+            "message": _echo(message, MAX_ECHO_MESSAGE),
+            "type": "value_error",
+        }
         for field, message in error.details
     ]
-    return problem_body(422, title, error.message, errors=errors)
+    return problem_body(status, title, _echo(error.message, MAX_ECHO_MESSAGE), errors=errors)
 
 
 def service_problem(error: ServiceUnavailableError) -> dict[str, Any]:
     """The 503 problem of an outside service that failed, naming it."""
     return problem_body(503, "Service unavailable", error.message, service=error.service)
+
+
+#: Longest part of a field path and longest message an error echoes [characters]: a client
+#: that sends a 5 MB property name gets a short answer, not its name back twice.
+MAX_ECHO_PART = 64
+MAX_ECHO_MESSAGE = 500
+
+
+def _echo(text: str, limit: int) -> str:
+    """What a client sent, cut to ``limit`` characters with a note of its length."""
+    return text if len(text) <= limit else f"{text[:limit]}… ({len(text):,} characters)"
 
 
 def _location(loc: tuple[Any, ...], kind: str = "") -> str:
@@ -65,7 +90,8 @@ def _location(loc: tuple[Any, ...], kind: str = "") -> str:
         return "body"
     path = ""
     for part in loc[1:] if loc and loc[0] == "body" else loc:
-        path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
+        name = _echo(str(part), MAX_ECHO_PART)
+        path += f"[{part}]" if isinstance(part, int) else (f".{name}" if path else name)
     return path or "body"
 
 
@@ -74,7 +100,7 @@ def _message(error: Any) -> str:
         position = error["loc"][-1] if error["loc"] else "?"
         reason = (error.get("ctx") or {}).get("error", "invalid JSON")
         return f"the body is not valid JSON at character {position}: {reason}"
-    return str(error["msg"])
+    return _echo(str(error["msg"]), MAX_ECHO_MESSAGE)
 
 
 def _handler(
@@ -104,7 +130,8 @@ def _validation(_: Request, error: RequestValidationError) -> JSONResponse:
 
 
 def _core(_: Request, error: CoreError) -> JSONResponse:
-    return JSONResponse(core_problem(error), status_code=422, media_type=PROBLEM_JSON)
+    body = core_problem(error)
+    return JSONResponse(body, status_code=body["status"], media_type=PROBLEM_JSON)
 
 
 def _http(request: Request, error: StarletteHTTPException) -> JSONResponse:

@@ -12,7 +12,6 @@ import time
 import uuid
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
-from contextvars import ContextVar
 from importlib.metadata import version
 from typing import Any
 
@@ -28,6 +27,7 @@ from app.execution import Executor
 from app.jobs.dispatch import CeleryDispatcher
 from app.jobs.local import LocalRunner
 from app.jobs.store import store_for
+from app.logs import REQUEST_ID, configure_logging
 from app.metrics import Metrics
 from app.operations.kinds import loaded
 from app.routers import fleet, health, jobs, plans, presets, simulate, studies
@@ -79,30 +79,45 @@ class BodyLimit:
         await self.app(scope, counting_receive, send)
 
     async def _reject(self, send: Send) -> None:
-        body = json.dumps(
-            {
-                "type": "/problems/request-too-large",
-                "title": "Request too large",
-                "status": 413,
-                "detail": f"request body exceeds {self.max_bytes} bytes",
-            }
-        ).encode()
-        await send(
-            {
-                "type": "http.response.start",
-                "status": 413,
-                "headers": [
-                    (b"content-type", errors.PROBLEM_JSON.encode()),
-                    (b"content-length", str(len(body)).encode()),
-                ],
-            }
-        )
-        await send({"type": "http.response.body", "body": body})
+        detail = f"request body exceeds {self.max_bytes} bytes"
+        await _send_problem(send, 413, "Request too large", detail)
 
 
-#: The id of the request being served (for the log lines written while serving it).
-REQUEST_ID: ContextVar[str] = ContextVar("coldroute_request_id", default="-")
 _REQUEST_ID_PATTERN = re.compile(r"^[A-Za-z0-9._:-]{1,128}$")
+#: The methods of HTTP (RFC 9110 and PATCH): any other token is a 501 and, in the metrics, one
+#: label ("OTHER"), so made-up methods cannot grow the metrics without bound.
+KNOWN_METHODS = frozenset(
+    {"GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS", "TRACE", "CONNECT"}
+)
+
+
+def _shown(text: str, limit: int = 40) -> str:
+    """A token a client sent, short enough to echo."""
+    return text if len(text) <= limit else f"{text[:limit]}…"
+
+
+async def _send_problem(
+    send: Send,
+    status: int,
+    title: str,
+    detail: str,
+    headers: tuple[tuple[bytes, bytes], ...] = (),
+    **extra: str,
+) -> None:
+    """Answer with a problem document from a middleware (before or instead of any router)."""
+    body = json.dumps(errors.problem_body(status, title, detail, **extra)).encode()
+    await send(
+        {
+            "type": "http.response.start",
+            "status": status,
+            "headers": [
+                (b"content-type", errors.PROBLEM_JSON.encode()),
+                (b"content-length", str(len(body)).encode()),
+                *headers,
+            ],
+        }
+    )
+    await send({"type": "http.response.body", "body": body})
 
 
 class RequestContext:
@@ -122,6 +137,7 @@ class RequestContext:
             await self.app(scope, receive, send)
             return
         started = time.perf_counter()
+        method = scope["method"] if scope["method"] in KNOWN_METHODS else "OTHER"
         sent = dict(scope["headers"]).get(b"x-request-id", b"").decode("latin-1")
         request_id = sent if _REQUEST_ID_PATTERN.match(sent) else uuid.uuid4().hex
         token = REQUEST_ID.set(request_id)
@@ -140,48 +156,39 @@ class RequestContext:
             await send(message)
 
         try:
-            await self.app(scope, receive, tagged_send)
+            if method == "OTHER":  # answered before routing: a made-up method is no route's
+                await _send_problem(
+                    tagged_send,
+                    501,
+                    "Not implemented",
+                    f"this service does not implement the method {_shown(scope['method'])}",
+                )
+            else:
+                await self.app(scope, receive, tagged_send)
         except Exception:
-            _log.exception(json.dumps({"error": "unexpected", "request_id": request_id}))
+            _log.exception("unexpected error")
             if not answered:
-                body = json.dumps(
-                    errors.problem_body(
-                        500,
-                        "Internal error",
-                        f"An unexpected error occurred; it has been logged as {request_id}.",
-                        request_id=request_id,
-                    )
-                ).encode()
-                await tagged_send(
-                    {
-                        "type": "http.response.start",
-                        "status": 500,
-                        "headers": [
-                            (b"content-type", errors.PROBLEM_JSON.encode()),
-                            (b"content-length", str(len(body)).encode()),
-                            (b"connection", b"close"),
-                        ],
-                    }
+                await _send_problem(
+                    tagged_send,
+                    500,
+                    "Internal error",
+                    f"An unexpected error occurred; it has been logged as {request_id}.",
+                    ((b"connection", b"close"),),
+                    request_id=request_id,
                 )
-                await send({"type": "http.response.body", "body": body})
         finally:
-            route = scope.get("route")
-            template = (
-                self.routes.template(scope["path"]) or getattr(route, "path", None) or "unmatched"
-            )
+            template = self.routes.template(scope["path"]) or "unmatched"
             seconds = time.perf_counter() - started
-            self.metrics.observe(scope["method"], template, status, seconds)
+            self.metrics.observe(method, template, status, seconds)
             _log.info(
-                json.dumps(
-                    {
-                        "method": scope["method"],
-                        "path": scope["path"],
-                        "route": template,
-                        "status": status,
-                        "duration_ms": round(seconds * 1000, 1),
-                        "request_id": request_id,
-                    }
-                )
+                "request",
+                extra={
+                    "method": method,
+                    "path": scope["path"],
+                    "route": template,
+                    "status": status,
+                    "duration_ms": round(seconds * 1000, 1),
+                },
             )
             REQUEST_ID.reset(token)
 
@@ -229,22 +236,36 @@ class Draining:
         if scope["type"] != "http" or not self.executor.draining or scope["path"] == "/healthz":
             await self.app(scope, receive, send)
             return
-        body = json.dumps(
-            errors.problem_body(503, "Service unavailable", "the server is shutting down")
-        ).encode()
-        await send(
-            {
-                "type": "http.response.start",
-                "status": 503,
-                "headers": [
-                    (b"content-type", errors.PROBLEM_JSON.encode()),
-                    (b"content-length", str(len(body)).encode()),
-                    (b"retry-after", b"1"),
-                    (b"connection", b"close"),
-                ],
-            }
+        await _send_problem(
+            send,
+            503,
+            "Service unavailable",
+            "the server is shutting down",
+            ((b"retry-after", b"1"), (b"connection", b"close")),
         )
-        await send({"type": "http.response.body", "body": body})
+
+
+class ProbesAnswerHead:
+    """``HEAD`` on the probes (``/healthz``, ``/readyz``) is their ``GET`` without the body,
+    as load balancers and container runtimes send it."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http" or scope["method"] != "HEAD" or scope["path"] not in PROBES:
+            await self.app(scope, receive, send)
+            return
+
+        async def headers_only(message: Message) -> None:
+            if message["type"] == "http.response.body":
+                message = {**message, "body": b""}
+            await send(message)
+
+        await self.app({**scope, "method": "GET"}, receive, headers_only)
+
+
+PROBES = frozenset({"/healthz", "/readyz"})
 
 
 def _drain_on_signals(executor: Executor) -> None:
@@ -293,9 +314,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
 def create_app(settings: Settings | None = None) -> FastAPI:
     """The ASGI application; ``settings`` overrides the environment (tests)."""
     settings = settings or get_settings()
-    logging.basicConfig(level=settings.log_level.upper(), format="%(message)s")
-    # One line per request is ours to write; the router and weather calls are not news.
-    logging.getLogger("httpx").setLevel(logging.WARNING)
+    configure_logging(settings.log_level)
     # Swagger UI and ReDoc from the service itself (fastapi-offline's pinned assets): the docs
     # work without internet.
     app = FastAPIOffline(
@@ -338,6 +357,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
     app.add_middleware(DocsPolicy)
     app.add_middleware(Draining, executor=executor)
+    app.add_middleware(ProbesAnswerHead)
     app.state.routes = RouteTemplates(app)
     app.add_middleware(RequestContext, metrics=metrics, routes=app.state.routes)
     generate = app.openapi

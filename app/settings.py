@@ -35,6 +35,12 @@ class Settings(BaseSettings):
     max_study_cell_stops: int = Field(
         2000, ge=1, description="Most cells × stops in one scenario study."
     )
+    max_sync_simulated_s: float = Field(
+        30_000_000.0,
+        gt=0,
+        description="Most time a synchronous study may simulate [s] (about a year of driving, "
+        "a few seconds of work); beyond, a 413 points to jobs, which have no such bound.",
+    )
     max_time_limit_s: float = Field(
         10.0, gt=0, description="Cap on a request's solver time_limit_s [s]."
     )

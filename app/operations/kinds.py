@@ -13,7 +13,12 @@ from pydantic import BaseModel
 from app.operations import fleet_plan, plan, studies
 from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
 from app.schemas.plans import PlanRequest, PlanResponse
-from app.schemas.studies import ScenariosRequest, ScenariosResponse
+from app.schemas.studies import (
+    ScenariosRequest,
+    ScenariosResponse,
+    SpeedSweepRequest,
+    SpeedSweepResponse,
+)
 from app.settings import Settings
 
 RequestT = TypeVar("RequestT", bound=BaseModel)
@@ -77,6 +82,15 @@ JOB_KINDS: dict[str, JobKind[Any, Any]] = {
         lambda _request, response: response,
         lambda request: request.plan.time_limit_s,
     ),
+    "speed-sweep": JobKind(
+        SpeedSweepRequest,
+        SpeedSweepResponse,
+        "of /v1/studies/speed-sweep",
+        studies.check_sweep,
+        studies.sweep_speeds,
+        lambda _request, response: response,
+        lambda _request: 0.0,  # no solver: the sweep's simulations alone
+    ),
 }
 
 
@@ -87,7 +101,12 @@ def loaded() -> None:
 def run_job(kind: str, request: dict[str, Any], settings: Settings) -> dict[str, Any]:
     """A job's result as JSON: exactly the synchronous endpoint's answer (jobs may solve up to
     ``max_job_time_limit_s``)."""
-    settings = settings.model_copy(update={"max_time_limit_s": settings.max_job_time_limit_s})
+    settings = settings.model_copy(
+        update={
+            "max_time_limit_s": settings.max_job_time_limit_s,
+            "max_sync_simulated_s": float("inf"),  # a job may simulate as long as it must
+        }
+    )
     job = JOB_KINDS[kind]
     validated = job.request.model_validate(request)
     return job.answer(validated, job.run(validated, settings)).model_dump(mode="json")

@@ -94,5 +94,5 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
         ),
         series=series,
         grid_kwh=result.grid_kwh,
-        warnings=warnings,
+        warnings=[*warnings, *result.warnings],
     )

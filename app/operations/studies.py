@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import datetime as dt
+
 from app import connectors
 from app.operations.answers import energy
 from app.operations.plan import check_plan, plan_problem
@@ -16,12 +18,12 @@ from app.schemas.studies import (
 )
 from app.settings import Settings
 from core.clock import departure
-from core.exceptions import CoreError, LimitExceededError
+from core.exceptions import CoreError, LimitExceededError, TooMuchToWaitForError
 from core.planning.studies import default_seasons, scenario_grid, speed_sweep
 
 
-def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepResponse:
-    """Energy per km at each constant speed (``POST /v1/studies/speed-sweep``)."""
+def sweep_start(request: SpeedSweepRequest, settings: Settings) -> dt.datetime:
+    """The sweep's departure, and each trip within the server's limit of samples."""
     start, _ = departure(request.date, request.start_time, request.timezone, request.location.lon)
     for index, speed_kmh in enumerate(request.speeds_kmh):
         # Each trip is a trace of its own: at least its distance at its speed, every second.
@@ -31,6 +33,26 @@ def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepRe
                 f"{settings.max_trace_samples} s; this server simulates at most that many samples",
                 f"speeds_kmh[{index}]",
             )
+    return start
+
+
+def check_sweep(request: SpeedSweepRequest, settings: Settings) -> None:
+    """Everything but the sweep itself: what a job refuses at submission."""
+    sweep_start(request, settings)
+
+
+def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepResponse:
+    """Energy per km at each constant speed (``POST /v1/studies/speed-sweep``)."""
+    start = sweep_start(request, settings)
+    simulated_s = sum(request.distance_m / (v / 3.6) for v in request.speeds_kmh if v > 0)
+    if simulated_s > settings.max_sync_simulated_s:
+        raise TooMuchToWaitForError(
+            f"{len(request.speeds_kmh)} trips of {request.distance_m:g} m simulate "
+            f"{simulated_s / 86_400:,.0f} days; a synchronous sweep simulates at most "
+            f"{settings.max_sync_simulated_s / 86_400:,.0f}: fewer speeds or a shorter trip, or "
+            "submit it as a job (POST /v1/jobs, type speed-sweep)",
+            "speeds_kmh",
+        )
     try:
         sweep = speed_sweep(
             request.speeds_kmh,
@@ -85,6 +107,7 @@ def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosRes
             request.traffic_density,
             router=connectors.router(settings),
             weather_service=connectors.weather_service(settings),
+            max_simulated_s=settings.max_sync_simulated_s,
         )
     except CoreError as error:  # the round's own fields sit under plan.
         if error.field is not None and error.field.startswith(("seasons", "plan")):

@@ -20,6 +20,8 @@ from app.settings import Settings
 from core.exceptions import CoreError
 
 router = APIRouter(prefix="/jobs", tags=["jobs"])
+#: Visible ASCII, no whitespace at either end.
+IDEMPOTENCY_KEY_PATTERN = r"^[!-~]([ -~]*[!-~])?$"
 
 
 def _validated(submission: JobSubmission, settings: Settings) -> BaseModel:
@@ -95,8 +97,12 @@ async def create_job(
     idempotency_key: Annotated[
         str | None,
         Header(
+            min_length=1,
             max_length=255,
-            description="Repeat a submission safely: the same key returns the same job.",
+            pattern=IDEMPOTENCY_KEY_PATTERN,
+            description="Repeat a submission safely: the same key returns the same job. 1–255 "
+            "visible ASCII characters (inner spaces allowed); an empty key would be one that "
+            "every such client shares.",
         ),
     ] = None,
 ) -> JobOut:

@@ -36,7 +36,8 @@ class UnassignedOut(ApiModel):
         ...,
         description="time_window (no van reaches it inside a window), capacity (no payload "
         "left or too heavy), battery (the charge would fall below a reserve), shift (no van "
-        "back in time) or unreachable (no road).",
+        "back in time), unreachable (no road) or time_limit (the search ran out of time before "
+        "it placed the stop; it may fit with a longer time_limit_s).",
     )
     detail: str = Field(..., description="Why, in a sentence.")
 

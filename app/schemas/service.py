@@ -26,7 +26,9 @@ class Health(ApiModel):
 class Check(ApiModel):
     """One dependency of the service."""
 
-    name: str = Field(..., description="workers, database, broker, osrm or weather.")
+    name: str = Field(
+        ..., description="workers, database, broker, celery_workers, osrm or weather."
+    )
     ok: bool = Field(..., description="Whether it answered.")
     detail: str = Field(..., description="What was checked, or what went wrong.")
     critical: bool = Field(

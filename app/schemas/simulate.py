@@ -26,6 +26,7 @@ from core.params import (
     IsoDateTime,
     Location,
     StreetTypeName,
+    TrafficDensity,
     Weather,
 )
 
@@ -36,7 +37,7 @@ class CycleRequest(ApiModel):
     street_type: StreetTypeName = Field("urban", description="Street type preset.")
     distance_m: float = Field(..., gt=0, le=1_000_000, description="Distance [m].")
     driver_aggressiveness: float = Field(NORMAL_DRIVER, ge=0, le=1, description="ε_d [–].")
-    traffic_density: float | None = Field(None, gt=0, lt=1, description="ε_t [–].")
+    traffic_density: TrafficDensity | None = Field(None, description="ε_t [–], 0.01–0.99.")
 
 
 class SimulateRequest(VanRequest):

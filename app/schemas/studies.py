@@ -8,7 +8,7 @@ from pydantic import Field
 
 from app.schemas.base import ApiModel, ConsumptionWhPerKm, EnergyKwh, VanRequest
 from app.schemas.plans import PlanRequest
-from core.params import ClockTime, IsoDate, Location, Weather, clock_field
+from core.params import ClockTime, IsoDate, Location, TrafficDensity, Weather, clock_field
 from core.planning.studies import Season
 
 
@@ -33,7 +33,7 @@ class SpeedSweepRequest(VanRequest):
     weather: Weather | None = Field(
         None, description="The day's forecast; absent: the climatology for date and latitude."
     )
-    traffic_density: float | None = Field(None, gt=0, lt=1, description="ε_t [–].")
+    traffic_density: TrafficDensity | None = Field(None, description="ε_t [–], 0.01–0.99.")
     driver_aggressiveness: float = Field(
         0.0, ge=0, le=1, description="ε_d [–]; 0 holds each speed exactly (paper Fig. 11)."
     )
@@ -73,9 +73,9 @@ class ScenariosRequest(ApiModel):
         None,
         min_length=1,
         max_length=10,
-        description="ε_d values [–]; absent: calm 0.2, normal 0.5, aggressive 1.0.",
+        description="ε_d values [–]; absent: calm 0.3, normal 0.5, aggressive 1.0.",
     )
-    traffic_density: list[Annotated[float, Field(gt=0, lt=1)]] | None = Field(
+    traffic_density: list[TrafficDensity] | None = Field(
         None,
         min_length=1,
         max_length=10,

@@ -17,6 +17,7 @@ from app.examples import (
     SIMULATE_EXAMPLE,
     SPEED_SWEEP_EXAMPLE,
 )
+from app.logs import JsonLines
 from app.main import app as default_app
 from app.main import create_app
 from app.settings import Settings
@@ -254,7 +255,9 @@ def test_an_unexpected_error_is_one_logged_500_that_closes_the_connection(caplog
     assert response.headers["x-request-id"] == "bug-report-7"
     assert response.json()["request_id"] == "bug-report-7" and "a bug" not in response.text
     tracebacks = [r for r in caplog.records if r.exc_info]
-    assert len(tracebacks) == 1 and "bug-report-7" in tracebacks[0].getMessage()
+    assert len(tracebacks) == 1
+    line = json.loads(JsonLines().format(tracebacks[0]))  # as the server's log writes it
+    assert line["request_id"] == "bug-report-7" and "RuntimeError: a bug" in line["error"]
 
 
 def test_request_id_is_taken_when_sane_and_made_otherwise(client):
