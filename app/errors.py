@@ -64,7 +64,7 @@ def core_problem(error: CoreError) -> dict[str, Any]:
         }
         for field, message in error.details
     ]
-    return problem_body(status, title, _echo(error.message, MAX_ECHO_MESSAGE), errors=errors)
+    return problem_body(status, title, _echo(error.message, MAX_ECHO_MESSAGE), **_listed(errors))
 
 
 def service_problem(error: ServiceUnavailableError) -> dict[str, Any]:
@@ -76,6 +76,16 @@ def service_problem(error: ServiceUnavailableError) -> dict[str, Any]:
 #: that sends a 5 MB property name gets a short answer, not its name back twice.
 MAX_ECHO_PART = 64
 MAX_ECHO_MESSAGE = 500
+#: Most entries a 422 lists: 100,000 empty stops in 400 kB would otherwise be 22 MB of errors.
+MAX_ERRORS = 50
+
+
+def _listed(errors: list[dict[str, str]], total: int | None = None) -> dict[str, Any]:
+    """The ``errors`` member of a 422 (the first :data:`MAX_ERRORS` of ``total``, all of
+    ``errors`` by default) and, when there were more, ``errors_omitted``: how many are not
+    listed."""
+    omitted = (len(errors) if total is None else total) - MAX_ERRORS
+    return {"errors": errors[:MAX_ERRORS]} | ({"errors_omitted": omitted} if omitted > 0 else {})
 
 
 def _echo(text: str, limit: int) -> str:
@@ -117,16 +127,19 @@ def _handler(
 
 
 def _validation(_: Request, error: RequestValidationError) -> JSONResponse:
+    found = error.errors()
     errors = [
         {
             "field": _location(tuple(e["loc"]), e["type"]),
             "message": _message(e),
             "type": e["type"],
         }
-        for e in error.errors()
+        for e in found[:MAX_ERRORS]
     ]
     detail = "; ".join(f"{e['field']}: {e['message']}" for e in errors[:5])
-    return problem(422, "Invalid request", detail, errors=errors)
+    if len(found) > 5:
+        detail += f"; and {len(found) - 5:,} more"
+    return problem(422, "Invalid request", detail, **_listed(errors, len(found)))
 
 
 def _core(_: Request, error: CoreError) -> JSONResponse:

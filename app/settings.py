@@ -9,6 +9,8 @@ from typing import Annotated
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from core.params import MAX_STOPS, MAX_TRACE_SAMPLES
+
 
 class Settings(BaseSettings):
     """Every knob of the service; each is an environment variable ``COLDROUTE_<NAME>``."""
@@ -27,9 +29,15 @@ class Settings(BaseSettings):
     api_key: SecretStr | None = Field(
         None, description="When set, every /v1 request needs this value in X-API-Key."
     )
-    max_stops: int = Field(500, ge=1, description="Most stops in one round.")
+    max_stops: int = Field(
+        500, ge=1, le=MAX_STOPS, description=f"Most stops in one round (at most {MAX_STOPS})."
+    )
     max_trace_samples: int = Field(
-        200_000, ge=2, description="Most samples in one simulated trace (55 h at 1 Hz)."
+        200_000,
+        ge=2,
+        le=MAX_TRACE_SAMPLES,
+        description="Most samples in one simulated trace (55 h at 1 Hz; at most "
+        f"{MAX_TRACE_SAMPLES:,}).",
     )
     max_body_bytes: int = Field(10_000_000, ge=1024, description="Largest request body [bytes].")
     max_study_cell_stops: int = Field(
@@ -131,6 +139,14 @@ class Settings(BaseSettings):
         gt=0,
         le=3600,
         description="A running job silent this long lost its worker and is run again [s].",
+    )
+    job_resend_after_s: float = Field(
+        120.0,
+        gt=0,
+        le=86_400,
+        description="With Celery: a job sent to the broker this long ago that has not started, "
+        "while the broker's queue is empty, lost its message (a worker died holding it) and is "
+        "sent again [s]. A broker that restarted gets its jobs again at once.",
     )
     job_max_attempts: int = Field(
         3, ge=1, le=20, description="Runs of a job before it is failed (worker lost, router down)."

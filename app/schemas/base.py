@@ -27,6 +27,7 @@ from core.params import (
     Preset,
     VanParams,
     VehicleParams,
+    few_unknown,
     get_preset,
     inside_validation,
 )
@@ -45,7 +46,7 @@ class ApiModel(BaseModel):
     def _keep_field_paths(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
         # Nested core parameter models report pydantic's errors with their full path.
         with inside_validation():
-            return handler(data)
+            return handler(few_unknown(cls, data))
 
 
 def _refuse_null(value: Any) -> Any:
@@ -353,7 +354,12 @@ class Problem(ApiModel):
     title: str = Field(..., description="A short summary of the problem kind.")
     status: int = Field(..., description="The HTTP status code.")
     detail: str = Field(..., description="What went wrong, for a person.")
-    errors: list[FieldError] | None = Field(None, description="For invalid requests.")
+    errors: list[FieldError] | None = Field(
+        None, description="For invalid requests: the offending fields, at most 50."
+    )
+    errors_omitted: int | None = Field(
+        None, description="How many more offending fields there are than errors lists."
+    )
     service: str | None = Field(
         None,
         description="For a 503: the service that is down (workers, database, osrm, weather).",

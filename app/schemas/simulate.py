@@ -20,6 +20,8 @@ from app.schemas.base import (
     absent,
 )
 from core.params import (
+    MAX_INTERVALS,
+    MAX_TRACE_SAMPLES,
     NORMAL_DRIVER,
     DoorOpening,
     Interval,
@@ -30,12 +32,17 @@ from core.params import (
     Weather,
 )
 
+#: A trace's samples: the first bad one is named (a million strings are one error, not a
+#: million).
+Samples = Field(max_length=MAX_TRACE_SAMPLES, fail_fast=True)
+Trace = Annotated[list[float], Samples, Field(min_length=2)]
+
 
 class CycleRequest(ApiModel):
     """Generate a speed trace (paper §2.2) instead of sending one."""
 
     street_type: StreetTypeName = Field("urban", description="Street type preset.")
-    distance_m: float = Field(..., gt=0, le=1_000_000, description="Distance [m].")
+    distance_m: float = Field(..., ge=1, le=1_000_000, description="Distance [m], 1 m–1000 km.")
     driver_aggressiveness: float = Field(NORMAL_DRIVER, ge=0, le=1, description="ε_d [–].")
     traffic_density: TrafficDensity | None = Field(None, description="ε_t [–], 0.01–0.99.")
 
@@ -47,11 +54,11 @@ class SimulateRequest(VanRequest):
         json_schema_extra={"oneOf": [{"required": ["speed_mps"]}, {"required": ["cycle"]}]}
     )
 
-    speed_mps: Annotated[Annotated[list[float], Field(min_length=2)] | None, NotNull] = absent(
-        "Speed samples [m/s], 0–69.4, every dt_s seconds, at least 2; give this or cycle."
+    speed_mps: Annotated[Annotated[list[float], Samples, Field(min_length=2)] | None, NotNull] = (
+        absent("Speed samples [m/s], 0–69.4, every dt_s seconds, at least 2; give this or cycle.")
     )
     dt_s: float = Field(1.0, ge=0.01, le=3600, description="Sampling interval [s].")
-    grade: float | list[float] = Field(
+    grade: float | Annotated[list[float], Samples] = Field(
         0.0, description="Road grade [–], one number or one per sample, within ±0.5."
     )
     cycle: Annotated[CycleRequest | None, NotNull] = absent(
@@ -65,10 +72,13 @@ class SimulateRequest(VanRequest):
         "the server has one, else the climatology for date and latitude.",
     )
     door_openings: list[DoorOpening] = Field(
-        default_factory=list, description="Cargo-door openings, seconds after the start."
+        default_factory=list,
+        max_length=MAX_INTERVALS,
+        description="Cargo-door openings, seconds after the start.",
     )
     parked: list[Interval] = Field(
         default_factory=list,
+        max_length=MAX_INTERVALS,
         description="When the van stands at a stop, seconds after the start: the cab HVAC's "
         "duty while parked (vehicle.cab_hvac_at_stops).",
     )

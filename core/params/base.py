@@ -23,6 +23,7 @@ from pydantic import (
     PlainSerializer,
     ValidationError,
     WithJsonSchema,
+    model_validator,
 )
 
 from core.exceptions import InvalidParameterError
@@ -124,12 +125,38 @@ def inside_validation() -> Iterator[None]:
         _INSIDE_VALIDATION.reset(token)
 
 
+#: Most samples of one trace any server takes (11.6 days at 1 Hz); a server's own limit
+#: (``COLDROUTE_MAX_TRACE_SAMPLES``) is at most this.
+MAX_TRACE_SAMPLES = 1_000_000
+#: Unknown properties of one object a 422 names: every one costs an entry, and a body of a
+#: million made-up keys would otherwise take seconds to refuse and megabytes to answer.
+MAX_UNKNOWN_NAMED = 5
+
+
+def few_unknown(model: type[BaseModel], data: Any) -> Any:
+    """``data`` keeping only the first :data:`MAX_UNKNOWN_NAMED` of the properties ``model``
+    does not have: the object is refused all the same, naming those."""
+    if not isinstance(data, dict) or len(data) <= len(model.model_fields) + MAX_UNKNOWN_NAMED:
+        return data
+    known = {name for name in model.model_fields} | {
+        info.alias for info in model.model_fields.values() if info.alias
+    }
+    unknown = [key for key in data if key not in known]
+    dropped = set(unknown[MAX_UNKNOWN_NAMED:])
+    return {key: value for key, value in data.items() if key not in dropped}
+
+
 class Params(BaseModel):
     """Base of every parameter model: frozen, no unknown fields, no NaN or infinity."""
 
     # Strict: no number from a string or a boolean (JSON clients get what the schema says);
     # dates and times still come from their ISO text (strict=False on those fields).
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False, strict=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _few_unknown(cls, data: Any) -> Any:
+        return few_unknown(cls, data)
 
     def __init__(self, **data: Any) -> None:
         if _INSIDE_VALIDATION.get():

@@ -35,6 +35,10 @@ class Location(Params):
     lon: float = Field(..., ge=-180, le=180, description="Longitude [°], east positive.")
 
 
+#: Most door openings, or parked spells, of one simulated trace.
+MAX_INTERVALS = 10_000
+
+
 class Interval(Params):
     """A span of time within a simulated trace."""
 

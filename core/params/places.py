@@ -4,13 +4,15 @@ matrices."""
 from __future__ import annotations
 
 import datetime as dt
-from typing import Annotated, Literal
+from typing import Annotated, Literal, TypeVar
 
 from pydantic import Field, ValidationError, ValidationInfo, field_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from core.params.base import ClockTime, Params
 from core.params.conditions import StreetTypeName
+
+T = TypeVar("T")
 
 
 class Depot(Params):
@@ -40,6 +42,9 @@ class TimeWindow(Params):
 
 #: Most time windows of one stop.
 MAX_TIME_WINDOWS = 8
+#: Most stops of one request any server takes; a server's own limit (``COLDROUTE_MAX_STOPS``)
+#: is at most this.
+MAX_STOPS = 5000
 
 
 class Stop(Depot):
@@ -92,18 +97,25 @@ MAX_MATRIX_DISTANCE_M = 1e8
 MAX_MATRIX_DURATION_S = 30 * 86_400.0
 
 
+#: A square table, row by row: a row's first bad cell is named (a row of 5,000 strings is
+#: one error, not 5,000).
+_Table = list[Annotated[list[T], Field(max_length=MAX_STOPS + 1, fail_fast=True)]]
+
+
 class RoadMatrix(Params):
     """Distances and durations from the client's road router: depot first, then the stops in
     request order."""
 
-    distances_m: list[list[Annotated[float, Field(ge=0, le=MAX_MATRIX_DISTANCE_M)]]] = Field(
-        ..., description="Road distance of each pair [m], 0–100,000 km."
+    distances_m: _Table[Annotated[float, Field(ge=0, le=MAX_MATRIX_DISTANCE_M)]] = Field(
+        ..., max_length=MAX_STOPS + 1, description="Road distance of each pair [m], 0–100,000 km."
     )
-    durations_s: list[list[Annotated[float, Field(ge=0, le=MAX_MATRIX_DURATION_S)]]] = Field(
-        ..., description="Driving time of each pair [s], 0–30 days."
+    durations_s: _Table[Annotated[float, Field(ge=0, le=MAX_MATRIX_DURATION_S)]] = Field(
+        ..., max_length=MAX_STOPS + 1, description="Driving time of each pair [s], 0–30 days."
     )
-    street_types: list[list[StreetTypeName]] | None = Field(
-        None, description="Street type of each pair; null chooses by leg length."
+    street_types: _Table[StreetTypeName] | None = Field(
+        None,
+        max_length=MAX_STOPS + 1,
+        description="Street type of each pair; null chooses by leg length.",
     )
 
 

@@ -15,6 +15,7 @@ from pydantic import Field, ValidationInfo, field_validator
 
 from core.exceptions import InvalidStopsError
 from core.params import (
+    MAX_STOPS,
     NORMAL_DRIVER,
     ClockTime,
     Depot,
@@ -48,13 +49,17 @@ FLEET_TIME_LIMIT_S = 5.0
 MAX_TIME_LIMIT_S = 600.0
 
 
+#: Least solver budget [s]: less is no search at all (and 1e-300 s is not a budget).
+MIN_TIME_LIMIT_S = 0.01
+
+
 def time_limit_field(default_s: float) -> float:
     """The ``time_limit_s`` field of a problem with its default [s]."""
     return Field(
         default_s,
-        gt=0,
+        ge=MIN_TIME_LIMIT_S,
         le=MAX_TIME_LIMIT_S,
-        description="Solver budget [s], capped by the server's setting.",
+        description="Solver budget [s], at least 0.01 s; capped by the server's setting.",
     )
 
 
@@ -68,7 +73,9 @@ class RoundFields(Params):
         description="IANA time zone (Europe/Vienna); absent: local mean solar time at the depot.",
     )
     depot: Depot = Field(..., description="Where the round starts and ends.")
-    stops: list[Stop] = Field(..., min_length=1, description="The stops, in any order.")
+    stops: list[Stop] = Field(
+        ..., min_length=1, max_length=MAX_STOPS, description="The stops, in any order."
+    )
     weather: Weather | None = Field(
         None, description="The day's forecast; absent: the climatology for date and latitude."
     )

@@ -158,12 +158,15 @@ def test_no_number_from_a_boolean_or_a_string(client, path, body, field):
     assert fields(client.post(path, json=body)) == [field]
 
 
-def test_a_matrix_of_strings_names_each_cell(client):
+def test_a_matrix_of_strings_names_the_first_bad_cell_of_each_row(client):
+    # One entry per row, not per cell: a 5,001-row matrix of strings is 5,001 errors, not 25 M.
     n = len(PLAN_EXAMPLE["stops"]) + 1
     distances = [["100" if i != j else 0 for j in range(n)] for i in range(n)]
     matrix = {"distances_m": distances, "durations_s": square(n, 60)}
     named = fields(client.post("/v1/plans", json=PLAN_EXAMPLE | {"matrix": matrix}))
-    assert named[0] == "matrix.distances_m[0][1]" and len(named) == n * (n - 1)
+    assert named == ["matrix.distances_m[0][1]"] + [
+        f"matrix.distances_m[{i}][0]" for i in range(1, n)
+    ]
 
 
 @pytest.mark.parametrize(
