@@ -84,7 +84,8 @@ class BodyLimit:
 
 
 _REQUEST_ID_PATTERN = re.compile(r"^[A-Za-z0-9._:-]{1,128}$")
-#: The methods of HTTP (RFC 9110 and PATCH): any other token is a 501 and, in the metrics, one
+#: The methods of HTTP (RFC 9110 and PATCH): any other token is answered before routing (405
+#: naming the path's methods, 404 on a path the service does not have) and counted under one
 #: label ("OTHER"), so made-up methods cannot grow the metrics without bound.
 KNOWN_METHODS = frozenset(
     {"GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS", "TRACE", "CONNECT"}
@@ -157,12 +158,7 @@ class RequestContext:
 
         try:
             if method == "OTHER":  # answered before routing: a made-up method is no route's
-                await _send_problem(
-                    tagged_send,
-                    501,
-                    "Not implemented",
-                    f"this service does not implement the method {_shown(scope['method'])}",
-                )
+                await self._unknown_method(scope, tagged_send)
             else:
                 await self.app(scope, receive, tagged_send)
         except Exception:
@@ -191,6 +187,21 @@ class RequestContext:
                 },
             )
             REQUEST_ID.reset(token)
+
+    async def _unknown_method(self, scope: Scope, send: Send) -> None:
+        allowed = sorted(self.routes.methods(scope["path"]))
+        if not allowed:
+            await _send_problem(send, 404, "Not found", "no such path")
+            return
+        await _send_problem(
+            send,
+            405,
+            "Method not allowed",
+            f"{_shown(scope['method'])} is not a method of {self.routes.template(scope['path'])}; "
+            "it takes "
+            f"{', '.join(allowed)}",
+            ((b"allow", ", ".join(allowed).encode()),),
+        )
 
 
 DOCS_PATHS = frozenset({"/docs", "/redoc"})
