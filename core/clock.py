@@ -160,7 +160,7 @@ def check_representable(start: dt.datetime, duration_s: float, field: str = "sta
     except OverflowError:
         raise InvalidParameterError(
             f"{_shown(start)} is too close to the start of the year 1, the first one "
-            "the service can represent; plan days from 0001-01-02 on",
+            "the service can represent; start on 0001-01-03 or later",
             field,
         ) from None
     try:

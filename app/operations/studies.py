@@ -19,7 +19,7 @@ from app.schemas.studies import (
 from app.settings import Settings
 from core.clock import departure
 from core.exceptions import CoreError, LimitExceededError, TooMuchToWaitForError
-from core.planning.studies import default_seasons, scenario_grid, speed_sweep
+from core.planning.studies import check_seasons, default_seasons, scenario_grid, speed_sweep
 
 
 def sweep_start(request: SpeedSweepRequest, settings: Settings) -> dt.datetime:
@@ -27,7 +27,7 @@ def sweep_start(request: SpeedSweepRequest, settings: Settings) -> dt.datetime:
     start, _ = departure(request.date, request.start_time, request.timezone, request.location.lon)
     for index, speed_kmh in enumerate(request.speeds_kmh):
         # Each trip is a trace of its own: at least its distance at its speed, every second.
-        if speed_kmh > 0 and request.distance_m / (speed_kmh / 3.6) > settings.max_trace_samples:
+        if request.distance_m / (speed_kmh / 3.6) > settings.max_trace_samples:
             raise LimitExceededError(
                 f"{request.distance_m:g} m at {speed_kmh:g} km/h takes more than "
                 f"{settings.max_trace_samples} s; this server simulates at most that many samples",
@@ -44,7 +44,7 @@ def check_sweep(request: SpeedSweepRequest, settings: Settings) -> None:
 def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepResponse:
     """Energy per km at each constant speed (``POST /v1/studies/speed-sweep``)."""
     start = sweep_start(request, settings)
-    simulated_s = sum(request.distance_m / (v / 3.6) for v in request.speeds_kmh if v > 0)
+    simulated_s = sum(request.distance_m / (v / 3.6) for v in request.speeds_kmh)
     if simulated_s > settings.max_sync_simulated_s:
         raise TooMuchToWaitForError(
             f"{len(request.speeds_kmh)} trips of {request.distance_m:g} m simulate "
@@ -129,3 +129,7 @@ def check_scenarios_job(request: ScenariosRequest, settings: Settings) -> None:
         check_plan(request.plan, settings)
     except CoreError as error:
         raise error.under("plan") from None
+    check_seasons(
+        plan_problem(request.plan, settings),
+        request.seasons or default_seasons(request.plan.date.year),
+    )

@@ -15,11 +15,13 @@ from core.planning.studies import Season
 class SpeedSweepRequest(VanRequest):
     """Constant-speed trips on a flat road at several speeds (paper Fig. 11)."""
 
-    speeds_kmh: list[float] = Field(
+    speeds_kmh: list[Annotated[float, Field(ge=1, le=200)]] = Field(
         default_factory=lambda: [float(v) for v in range(20, 121, 10)],
         min_length=1,
         max_length=100,
-        description="Mean speeds to try [km/h], each in (0, 200].",
+        description="Mean speeds to try [km/h], each 1–200. A driver who is not passive "
+        "swings around each speed in the highway's waves, narrower near 200 km/h so that no "
+        "swing exceeds 250 km/h.",
     )
     distance_m: float = Field(
         20_000.0, ge=100, le=500_000, description="Trip length [m], at least 100 m."

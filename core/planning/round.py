@@ -158,10 +158,18 @@ def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
             f"{problem.van.payload_kg:g} kg",
             "stops",
         )
+    start, timezone_name = round_start(problem)
+    if problem.matrix is not None:
+        build_legs(problem.places, problem.matrix)
+    return start, timezone_name
+
+
+def round_start(problem: PlanProblem) -> tuple[dt.datetime, str]:
+    """The round's departure and the zone's name, for a day and a start time the clock has
+    and a round of the longest duration the planner simulates can follow; raises
+    :class:`core.exceptions.InvalidParameterError` naming ``date`` or ``start_time``."""
     start, timezone_name = departure(
         problem.date, problem.start_time, problem.timezone, problem.depot.lon
     )
-    check_representable(start, MAX_ROUND_S, "date")  # the longest round the planner simulates
-    if problem.matrix is not None:
-        build_legs(problem.places, problem.matrix)
+    check_representable(start, MAX_ROUND_S, "date")
     return start, timezone_name

@@ -40,3 +40,12 @@ def test_a_full_fleet_names_the_rule_that_keeps_the_stop_out():
     # Five stops of 100 kg fill the van: the sixth fits nowhere by payload.
     why = explain(rules, 6, None, [[1, 2, 3, 4, 5]])
     assert why.reason == "capacity" and "full" in why.detail
+
+
+def test_a_stop_that_fits_a_route_by_every_rule_was_left_by_the_time_limit():
+    # Issue #21: a search out of time left stops that fitted, and the answer said "shift".
+    stops, matrix = two_clusters(delivery_kg=100)
+    rules = rules_for(fleet(stops, [van("a", payload_kg=800)], matrix=matrix))
+    why = explain(rules, 6, None, [[1, 2]])
+    assert why.reason == "time_limit" and "time_limit_s" in why.detail
+    assert rules.violations(0, [1, 2, 6]) == []  # it does fit: the reason is not a rule

@@ -5,10 +5,21 @@ import numpy as np
 import pytest
 
 from core.exceptions import InvalidParameterError
-from core.params import CargoBoxParams, Depot, Location, Stop, VanParams, VehicleParams, Weather
+from core.params import (
+    STREET_TYPES,
+    CargoBoxParams,
+    Depot,
+    Location,
+    Stop,
+    VanParams,
+    VehicleParams,
+    Weather,
+)
+from core.physics.cycles import generate_leg, trace_distance_m
+from core.physics.simulate import MAX_SPEED_MPS
 from core.planning.model import PlanProblem
 from core.planning.round import plan
-from core.planning.studies import Season, scenario_grid, speed_sweep
+from core.planning.studies import Season, scenario_grid, speed_sweep, sweep_street
 
 NOON = dt.datetime(2026, 7, 15, 12, tzinfo=ZoneInfo("Europe/Vienna"))
 VIENNA = Location(lat=48.21, lon=16.37)
@@ -39,6 +50,27 @@ def test_more_constant_load_moves_the_optimum_up():
     )
     more = speed_sweep(fine, 20_000, NOON, VIENNA, heavier, HOT)
     assert more.optimum_speed_kmh > base.optimum_speed_kmh
+
+
+@pytest.mark.parametrize("speed_kmh", [60.0, 150.0, 180.0, 199.0, 200.0])
+def test_every_allowed_sweep_speed_swings_within_the_top_speed(speed_kmh):
+    # Issue #21: 200 km/h with any driver who is not passive swung to 259 km/h (the highway's
+    # ±30 %) and failed naming a sample the client never sent.
+    street = sweep_street(speed_kmh)
+    for aggressiveness in (0.05, 0.3, 1.0):
+        for density in (0.01, 0.5, 0.99):
+            for distance_m in (100.0, 20_000.0, 500_000.0):
+                trace = generate_leg(distance_m, street, aggressiveness, 3.0, density)
+                assert trace.max() <= MAX_SPEED_MPS
+                assert trace_distance_m(trace, 1.0) == pytest.approx(distance_m)
+    # Away from the top speed the waves are the highway's own.
+    assert sweep_street(60.0).speed_variation == STREET_TYPES["highway"].speed_variation
+
+
+def test_a_sweep_at_the_top_speed_with_an_aggressive_driver_is_answered():
+    sweep = speed_sweep([50.0, 200.0], 20_000, NOON, VIENNA, VanParams(), HOT, 1.0)
+    fast, slow = sweep.points[1].energy_wh_per_km, sweep.points[0].energy_wh_per_km
+    assert fast["traction"] > 3 * slow["traction"]  # drag ∝ v²: (200/50)² = 16 per km at the wheel
 
 
 def test_sweep_rejects_bad_speeds():
