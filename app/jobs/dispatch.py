@@ -42,11 +42,6 @@ class CeleryDispatcher:
             with contextlib.suppress(asyncio.CancelledError):
                 await self._task
 
-    @property
-    def resend_after_s(self) -> float:
-        """How long a sent job may wait to start before its message counts as lost [s]."""
-        return max(10 * self.settings.job_stale_after_s, 120.0)
-
     async def submitted(self, job: JobView) -> None:
         """A job was queued: send it now, or — the broker being down — when it is back."""
         try:
@@ -56,7 +51,7 @@ class CeleryDispatcher:
 
     def dispatch(self, job_id: str) -> None:
         """Send one attempt of a job to the workers, unless another dispatcher just did."""
-        if not self.store.take_dispatch(job_id, self.resend_after_s):
+        if not self.store.take_dispatch(job_id, self.settings.job_resend_after_s):
             return
         try:
             self.celery.send_task(TASK, args=[job_id], task_id=f"{job_id}.{uuid.uuid4().hex[:8]}")
@@ -78,7 +73,7 @@ class CeleryDispatcher:
             resend = broker == "other"
         # Never sent (the broker was down, or a crash between storing and sending) and due; and,
         # with nothing waiting in the queue, sent long ago without starting.
-        for job in self.store.undispatched(self.resend_after_s if resend else None):
+        for job in self.store.undispatched(self.settings.job_resend_after_s if resend else None):
             self.dispatch(job.id)
 
     def _broker(self) -> tuple[str, int] | Literal["other", "down"]:
