@@ -39,8 +39,8 @@ from core.routing.tsp import SolverStatus
 MAX_ROUND_S = 7 * 86_400.0
 #: Most vans in one fleet plan.
 MAX_VEHICLES = 100
-#: Solver budget of one round [s] when the request gives none: everyday rounds are proven
-#: optimal well within it.
+#: Solver budget of one round [s] when the request gives none: rounds of up to about 60 stops
+#: are proven optimal within it, larger ones come within about 0.1 % of LKH-3.
 PLAN_TIME_LIMIT_S = 1.0
 #: Solver budget of a fleet [s] when the request gives none: the split across vans and the
 #: verification by simulation take longer than one round.

@@ -1,24 +1,23 @@
-"""The round trip: one van, start and end at the depot (paper §4), with OR-Tools.
+"""The round trip: one van, start and end at the depot (paper §4).
 
-Three tools, each where it is strongest (measured on TSPLIB and random instances,
-``benchmarks/bench_planner.py``):
+Two tools, each where it is strongest (measured beside LKH-3 on clustered, uniform and TSPLIB
+rounds, ``benchmarks/bench_planner.py``):
 
-1. CP-SAT's circuit constraint with its LP relaxation (linearization level 2) and the 2-cycle
-   cuts ``x_ij + x_ji ≤ 1``, which the circuit's LP lacks and which make it much tighter. Up to
-   :data:`FULL_GRAPH_MAX_NODES` places it runs on every arc and proves the optimum in tens of
-   milliseconds.
-2. Beyond that, the same model on each place's :data:`NEIGHBOURS` nearest successors and
-   predecessors (plus the arcs of the start tour): a tenth of the arcs, so the LP and the
-   search are several times faster. Its optimum is optimal over those arcs — in every TSPLIB
-   and random instance checked it is the true optimum — but it is not a proof over all arcs,
-   so the status is ``feasible``.
-3. When CP-SAT neither proves nor finishes, the OR-Tools routing library's guided local search
-   improves its best tour for the rest of the budget (operators that apply to one route only).
-   Above :data:`EXACT_MAX_NODES` it has the whole budget.
+1. An iterated local search (:mod:`core.routing.ils`: 2-opt and Or-opt on near places and
+   the spanning tree's links, double-bridge kicks), :data:`RUNS` runs from Christofides' tour
+   with their own seeds, the best kept. Each run ends at its share of the budget or after
+   :data:`STALL_KICKS` kicks without improvement.
+2. CP-SAT's circuit constraint with its LP relaxation (linearization level 2) and the 2-cycle
+   cuts ``x_ij + x_ji ≤ 1``, which the circuit's LP lacks and which make it much tighter, on
+   every arc: from the local search's tour it proves the optimum of rounds up to
+   :data:`PROOF_MAX_NODES` places within a few hundred milliseconds, of rounds up to
+   :data:`FULL_GRAPH_MAX_NODES` places in tens. A proof over every arc is the only
+   ``optimal`` status; a model on fewer arcs (each place's nearest, say) proves nothing, for on
+   clustered rounds the arcs between clusters that the best tour takes are seldom among them.
 
-Every search is single-threaded and deterministic, so a busy second core does not change the
-answer, and the time limit is a deadline: nothing runs past it. Costs are non-negative
-integers: the caller rounds explicitly (metres, seconds, Wh).
+Every search is single-threaded and seeded, so a busy second core does not change the answer
+when the search ends before its limit, and the time limit is a deadline: nothing runs past it.
+Costs are non-negative integers: the caller rounds explicitly (metres, seconds, Wh).
 """
 
 from __future__ import annotations
@@ -34,16 +33,23 @@ from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 from ortools.sat.python import cp_model
 
 from core.exceptions import InvalidParameterError
+from core.routing.ils import iterated_local_search
 
 SolverStatus = Literal["optimal", "feasible", "fixed_order"]
-#: Rounds up to this many nodes (depot included) are solved on the full graph (a proof).
+#: Rounds up to this many nodes (depot included) are proven on the full graph from
+#: Christofides' tour with the whole budget: tens of milliseconds.
 FULL_GRAPH_MAX_NODES = 30
-#: Rounds up to this many nodes go to CP-SAT; larger ones to routing alone.
-EXACT_MAX_NODES = 150
-#: Nearest successors and predecessors of each node kept in the sparse CP-SAT model.
-NEIGHBOURS = 7
-#: Share of the budget CP-SAT has before guided local search takes over its best tour.
-EXACT_TIME_SHARE = 0.7
+#: Up to this many, the full graph has what the local search leaves of the budget: a proof in
+#: a few hundred milliseconds on most delivery rounds.
+PROOF_MAX_NODES = 60
+#: Share of the budget the local search has before a proof is tried, and the share by which
+#: the proof must end (the local search has the rest).
+PROOF_SEARCH_SHARE = 0.3
+PROOF_SHARE_END = 0.8
+#: Independent runs of the local search sharing its budget.
+RUNS = 3
+#: Kicks without improvement after which a run of the local search ends early.
+STALL_KICKS = 20_000
 
 
 @dataclass(frozen=True)
@@ -90,8 +96,7 @@ def solve_tour(
     Returns
     -------
     Tour
-        Deterministic for the same input when the search ends before the time limit (always
-        when CP-SAT finishes; the guided local search stops only at its time limit).
+        Deterministic for the same input when the search ends before the time limit.
     """
     cost = np.asarray(cost, dtype=np.int64)
     n = cost.shape[0]
@@ -111,19 +116,34 @@ def solve_tour(
             order = min(([0, 1, 2, 0], [0, 2, 1, 0]), key=lambda o: tour_cost(cost, o))
         return done(order, "fixed_order" if keep_order else "optimal")
     start = _first_tour(cost)
-    if n > EXACT_MAX_NODES:
+    if n > PROOF_MAX_NODES:
         return done(_improve(cost, start, deadline), "feasible")
-    full = n <= FULL_GRAPH_MAX_NODES
-    exact_deadline = deadline if full else started + time_limit_s * EXACT_TIME_SHARE
-    found, proven = _solve_exact(cost, start, exact_deadline, None if full else NEIGHBOURS)
-    best = (
-        found if found is not None and tour_cost(cost, found) <= tour_cost(cost, start) else start
-    )
+    best, proof_deadline = start, deadline
+    if n > FULL_GRAPH_MAX_NODES:
+        best = _improve(cost, start, started + time_limit_s * PROOF_SEARCH_SHARE)
+        proof_deadline = started + time_limit_s * PROOF_SHARE_END
+    found, proven = _solve_exact(cost, best, proof_deadline)
+    if found is not None and tour_cost(cost, found) <= tour_cost(cost, best):
+        best = found
     if proven:
-        return done(best, "optimal" if full else "feasible")
-    if time.perf_counter() < deadline - _ROUTING_STOP_MARGIN_S:
-        best = _improve(cost, best, deadline)
-    return done(best, "feasible")
+        return done(best, "optimal")
+    return done(_improve(cost, best, deadline), "feasible")
+
+
+def _improve(cost: NDArray[np.int64], start: list[int], deadline: float) -> list[int]:
+    """The best of :data:`RUNS` local searches from ``start``, sharing the time to
+    ``deadline`` (a ``time.perf_counter`` value); ``start`` if no time is left."""
+    best = start
+    for run in range(RUNS):
+        remaining = deadline - time.perf_counter()
+        if remaining <= 0:
+            break
+        found = iterated_local_search(
+            cost, start, time.perf_counter() + remaining / (RUNS - run), 1000 * run, STALL_KICKS
+        )
+        if tour_cost(cost, found) < tour_cost(cost, best):
+            best = found
+    return best
 
 
 #: Time kept back from CP-SAT's budget for its own stopping and for reading the solution, a
@@ -132,33 +152,20 @@ _EXACT_STOP_MARGIN_S = 0.010
 _EXACT_STOP_MARGIN_PER_ARC_S = 2.5e-6
 
 
-def _arcs(cost: NDArray[np.int64], start: list[int], neighbours: int | None) -> NDArray[np.bool_]:
-    """Which arcs the CP-SAT model has: all, or each node's nearest successors and
-    predecessors plus the start tour's arcs."""
-    n = cost.shape[0]
-    if neighbours is None or neighbours >= n - 1:
-        keep = np.ones((n, n), dtype=bool)
-    else:
-        ranked = cost.astype(float)
-        np.fill_diagonal(ranked, np.inf)
-        keep = np.zeros((n, n), dtype=bool)
-        rows = np.arange(n)
-        keep[rows[:, None], np.argsort(ranked, axis=1)[:, :neighbours]] = True
-        keep[np.argsort(ranked, axis=0)[:neighbours, :], rows[None, :]] = True
-        keep[start[:-1], start[1:]] = True
-    np.fill_diagonal(keep, False)
-    return keep
-
-
 def _solve_exact(
-    cost: NDArray[np.int64], start: list[int], deadline: float, neighbours: int | None
+    cost: NDArray[np.int64],
+    start: list[int],
+    deadline: float,
+    keep: NDArray[np.bool_] | None = None,
 ) -> tuple[list[int] | None, bool]:
     """CP-SAT with a circuit constraint, its LP relaxation and 2-cycle cuts, from ``start``,
     to finish by ``deadline`` (a ``time.perf_counter`` value); one worker, so the search is
     deterministic. The best tour found (or None) and whether it is proven optimal over the
-    model's arcs."""
+    model's arcs: every arc, or those of ``keep`` and of ``start``."""
     n = cost.shape[0]
-    keep = _arcs(cost, start, neighbours)
+    keep = np.ones((n, n), dtype=bool) if keep is None else keep.copy()
+    keep[start[:-1], start[1:]] = True
+    np.fill_diagonal(keep, False)
     model = cp_model.CpModel()
     arcs = {
         (int(i), int(j)): model.new_bool_var("") for i, j in zip(*np.nonzero(keep), strict=True)
@@ -194,29 +201,6 @@ def _solve_exact(
     return order, result == cp_model.OPTIMAL
 
 
-# Routing operators that only act on optional visits, pickup-delivery pairs or several routes:
-# useless for one van visiting every stop, and they cost search time.
-_IDLE_OPERATORS = (
-    "use_relocate_pair",
-    "use_make_active",
-    "use_make_inactive",
-    "use_make_chain_inactive",
-    "use_swap_active",
-    "use_exchange_pair",
-    "use_light_relocate_pair",
-    "use_relocate_subtrip",
-    "use_exchange_subtrip",
-    "use_relocate_path_global_cheapest_insertion_insert_unperformed",
-    "use_shortest_path_swap_active",
-    "use_swap_active_chain",
-    "use_global_cheapest_insertion_visit_types_lns",
-    "use_local_cheapest_insertion_visit_types_lns",
-)
-_BOOL_FALSE = 2  # ortools.util.optional_boolean_pb2.BOOL_FALSE
-#: Time kept back from the routing search for stopping and reading the tour [s].
-_ROUTING_STOP_MARGIN_S = 0.010
-
-
 def _routing(cost: NDArray[np.int64]) -> tuple[pywrapcp.RoutingIndexManager, pywrapcp.RoutingModel]:
     n = cost.shape[0]
     manager = pywrapcp.RoutingIndexManager(n, 1, 0)
@@ -245,25 +229,3 @@ def _first_tour(cost: NDArray[np.int64]) -> list[int]:
     params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.CHRISTOFIDES
     params.solution_limit = 1
     return _read(manager, routing, routing.SolveWithParameters(params))
-
-
-def _improve(cost: NDArray[np.int64], start: list[int], deadline: float) -> list[int]:
-    """Guided local search from ``start`` until ``deadline`` (a ``time.perf_counter`` value),
-    with the multi-armed-bandit operator schedule; the better of start and result."""
-    manager, routing = _routing(cost)
-    params = pywrapcp.DefaultRoutingSearchParameters()
-    params.use_multi_armed_bandit_concatenate_operators = True
-    for operator in _IDLE_OPERATORS:
-        setattr(params.local_search_operators, operator, _BOOL_FALSE)
-    params.local_search_metaheuristic = (
-        routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
-    )
-    budget_s = deadline - time.perf_counter() - _ROUTING_STOP_MARGIN_S
-    params.time_limit.FromMilliseconds(max(int(budget_s * 1000), 1))
-    routing.CloseModelWithParameters(params)
-    initial = routing.ReadAssignmentFromRoutes([start[1:-1]], True)
-    solution = routing.SolveFromAssignmentWithParameters(initial, params)
-    if solution is None:
-        return start
-    improved = _read(manager, routing, solution)
-    return min((improved, start), key=lambda order: tour_cost(cost, order))
