@@ -1,14 +1,18 @@
-"""Fleet planning: Solomon's RC208 beside PyVRP at the same budget, and a battery-limited day
+"""Fleet planning: Solomon's instances beside PyVRP at the same budget, and a battery-limited day
 where a plan without the energy constraint sends vans out that the simulation says run flat."""
 
 from __future__ import annotations
 
 import datetime as dt
 import math
+import resource
 import time
+from dataclasses import dataclass
+from multiprocessing import Queue, get_context
 
 import numpy as np
-from pyvrp import Model
+from pyvrp import Client, Location, ProblemData, VehicleType, solve
+from pyvrp import Depot as PyvrpDepot
 from pyvrp.stop import MaxRuntime
 
 from benchmarks.common import REFERENCE, print_table
@@ -17,60 +21,124 @@ from core.planning.fleet import plan_fleet
 from core.planning.model import FleetProblem, FleetResult, FleetVehicle, PlanProblem
 from core.planning.round import plan
 
-#: RC208 as a city: one coordinate unit is 1 km, one time unit a minute (60 km/h, the
-#: literature's travel time = distance), the horizon 00:00–16:00.
-KM_M = 1000.0
+#: Solomon's instances as a city: one distance unit is ``UNIT_KM[name]`` km and the same time
+#: unit that many minutes (60 km/h, the literature's travel time = distance), so the horizon
+#: fits in a day (C201's 3390 units are 22.6 h at 0.4 min). Windows become whole minutes
+#: (opening rounded up, closing down), and PyVRP solves the same rounded instance.
+UNIT_KM = {"C201": 0.4}
+#: The seven instances and their best-known values: distance only, (fewest vans, distance).
+SOLOMON = {
+    "C101": (827.3, (10, 828.94)),
+    "C201": (589.1, (3, 591.56)),
+    "R101": (1637.7, (19, 1650.80)),
+    "R201": (1143.2, (4, 1252.37)),
+    "RC101": (1619.8, (14, 1696.94)),
+    "RC201": (1261.8, (4, 1406.94)),
+    "RC208": (776.1, (3, 828.14)),
+}
 MINUTE_S = 60.0
-#: PyVRP works on integers: coordinates and times scaled by this, as in its own benchmarks.
+#: PyVRP works on integers: distances scaled by this, as in its own benchmarks.
 PYVRP_SCALE = 100
+VANS = 25
 
 
-def rc208() -> tuple[np.ndarray, list[list[float]]]:
+@dataclass(frozen=True)
+class Solomon:
+    """One instance in minutes: the depot first, then the customers."""
+
+    name: str
+    xy: np.ndarray  # the instance's units
+    distance: np.ndarray
+    minutes_per_unit: float
+    demand: list[float]
+    service_min: list[float]
+    window_min: list[tuple[int, int]]  # whole minutes, the depot's the horizon
+    capacity: float
+
+    @property
+    def km_per_unit(self) -> float:
+        return self.minutes_per_unit
+
+
+def solomon(name: str) -> Solomon:
+    lines = (REFERENCE / "vrptw" / f"{name}.txt").read_text().splitlines()
+    capacity = next(
+        float(line.split()[1])
+        for k, line in enumerate(lines)
+        if k and "CAPACITY" in lines[k - 1] and len(line.split()) == 2
+    )
     rows = [
         [float(x) for x in line.split()]
-        for line in (REFERENCE / "vrptw" / "RC208.txt").read_text().splitlines()
+        for line in lines
         if line.split() and line.split()[0].isdigit() and len(line.split()) == 7
     ]
     xy = np.array([[r[1], r[2]] for r in rows])
-    return np.sqrt(((xy[:, None] - xy[None]) ** 2).sum(-1)), rows
+    scale = UNIT_KM.get(name, 1.0)
+    horizon = math.floor(rows[0][5] * scale) - 1  # shifts end before midnight
+    windows = [(math.ceil(r[4] * scale), min(math.floor(r[5] * scale), horizon)) for r in rows]
+    return Solomon(
+        name,
+        xy,
+        np.sqrt(((xy[:, None] - xy[None]) ** 2).sum(-1)),
+        scale,
+        [r[3] for r in rows],
+        [r[6] * scale for r in rows],
+        [(0, horizon), *windows[1:]],
+        capacity,
+    )
 
 
 def clock(minutes: float) -> str:
     return f"{int(minutes) // 60:02d}:{int(minutes) % 60:02d}"
 
 
-def rc208_problem(time_limit_s: float, minimize_vehicles: bool) -> FleetProblem:
-    distance, rows = rc208()
-    depot, customers = rows[0], rows[1:]
+def solomon_problem(
+    instance: Solomon, time_limit_s: float, minimize_vehicles: bool
+) -> FleetProblem:
     van = (
         PRESETS["paper-generic"]
         .van()
         .model_copy(
-            update={"battery": BatteryParams(usable_capacity_kwh=1000.0), "payload_kg": 1000.0}
+            update={
+                "battery": BatteryParams(usable_capacity_kwh=1000.0),
+                "payload_kg": instance.capacity,
+            }
         )
     )
-    end = clock(depot[5] - 1)  # shifts end before midnight's 16:00 → "15:59"
+    unit_m = instance.km_per_unit * 1000.0
+    unit_s = instance.minutes_per_unit * MINUTE_S
     return FleetProblem(
         date=dt.date(2026, 4, 15),
         timezone="UTC",
-        depot=Depot(id="depot", lat=48.0 + depot[2] / 111, lon=16.0 + depot[1] / 74),
+        depot=Depot(
+            id="depot",
+            lat=48.0 + instance.xy[0, 1] * instance.km_per_unit / 111,
+            lon=16.0 + instance.xy[0, 0] * instance.km_per_unit / 74,
+        ),
         vehicles=[
-            FleetVehicle(id=f"v{k}", van=van, shift_start="00:00", shift_end=end) for k in range(25)
+            FleetVehicle(
+                id=f"v{k}", van=van, shift_start="00:00", shift_end=clock(instance.window_min[0][1])
+            )
+            for k in range(VANS)
         ],
         stops=[
             Stop(
-                id=f"c{int(r[0])}",
-                lat=48.0 + r[2] / 111,
-                lon=16.0 + r[1] / 74,
-                delivery_kg=r[3],
-                service_time_s=r[6] * MINUTE_S,
-                door_open_s=60.0,
-                time_windows=[TimeWindow(start=clock(r[4]), end=clock(min(r[5], depot[5] - 1)))],
+                id=f"c{k}",
+                lat=48.0 + instance.xy[k, 1] * instance.km_per_unit / 111,
+                lon=16.0 + instance.xy[k, 0] * instance.km_per_unit / 74,
+                delivery_kg=instance.demand[k],
+                service_time_s=instance.service_min[k] * MINUTE_S,
+                door_open_s=min(60.0, instance.service_min[k] * MINUTE_S),
+                time_windows=[TimeWindow(start=clock(a), end=clock(b))]
+                if (a, b) != (0, instance.window_min[0][1])
+                else [],
             )
-            for r in customers
+            for k, (a, b) in enumerate(instance.window_min)
+            if k
         ],
         matrix=RoadMatrix(
-            distances_m=(distance * KM_M).tolist(), durations_s=(distance * MINUTE_S).tolist()
+            distances_m=(instance.distance * unit_m).tolist(),
+            durations_s=(instance.distance * unit_s).tolist(),
         ),
         weather=Weather(t_min_c=8, t_max_c=18),
         objective="distance",
@@ -79,58 +147,74 @@ def rc208_problem(time_limit_s: float, minimize_vehicles: bool) -> FleetProblem:
     )
 
 
-def pyvrp_rc208(time_limit_s: float) -> tuple[float, int]:
-    distance, rows = rc208()
-    scaled = np.rint(distance * PYVRP_SCALE).astype(int)
-    model = Model()
-    places = [
-        model.add_location(x=int(r[1] * PYVRP_SCALE), y=int(r[2] * PYVRP_SCALE)) for r in rows
-    ]
-    model.add_depot(places[0], tw_early=0, tw_late=int(rows[0][5] * PYVRP_SCALE))
-    model.add_vehicle_type(num_available=25, capacity=1000, tw_late=int(rows[0][5] * PYVRP_SCALE))
-    for r, place in zip(rows[1:], places[1:], strict=True):
-        model.add_client(
-            place,
-            delivery=int(r[3]),
-            service_duration=int(r[6] * PYVRP_SCALE),
-            tw_early=int(r[4] * PYVRP_SCALE),
-            tw_late=int(r[5] * PYVRP_SCALE),
-        )
-    for i, a in enumerate(places):
-        for j, b in enumerate(places):
-            model.add_edge(a, b, distance=int(scaled[i, j]), duration=int(scaled[i, j]))
-    result = model.solve(stop=MaxRuntime(time_limit_s), seed=1, display=False)
-    assert result.is_feasible()
-    return result.cost() / PYVRP_SCALE, result.best.num_routes()
-
-
-def rc208_table() -> None:
-    rows = []
-    for budget in (10.0, 60.0):
-        theirs, their_routes = pyvrp_rc208(budget)
-        for minimize in (False, True):
-            started = time.perf_counter()
-            ours = plan_fleet(rc208_problem(budget, minimize))
-            elapsed = time.perf_counter() - started
-            km = ours.distance_m / KM_M
-            rows.append(
-                [
-                    f"{budget:.0f} s",
-                    "distance" if not minimize else "vans, then distance",
-                    f"{km:.1f}",
-                    ours.vehicles_used,
-                    len(ours.unassigned),
-                    f"{theirs:.1f}",
-                    their_routes,
-                    f"{(km / theirs - 1) * 100:+.2f} %",
-                    f"{elapsed:.1f}",
-                    ours.verification_rounds,
-                ]
-            )
-    print_table(
-        "Solomon RC208 (100 customers, windows, capacity 1000): coldroute vs PyVRP 0.14, same "
-        "budget, same run (best known 776.1 with 3 vans)",
+def pyvrp_solomon(
+    instance: Solomon, time_limit_s: float, minimize_vehicles: bool
+) -> tuple[float, int]:
+    """PyVRP on the same instance at the same budget: distance [units] and vans; with
+    ``minimize_vehicles`` a fixed cost per van larger than any set of routes."""
+    per_minute = PYVRP_SCALE / instance.minutes_per_unit
+    distance = np.rint(instance.distance * PYVRP_SCALE).astype(np.int64)
+    n = distance.shape[0]
+    fixed = int(distance.max() * 2 * n) if minimize_vehicles else 0
+    horizon = int(instance.window_min[0][1] * per_minute)
+    data = ProblemData(
+        [Location(0.0, 0.0) for _ in range(n)],
         [
+            Client(
+                location=k,
+                delivery=[int(instance.demand[k])],
+                service_duration=round(instance.service_min[k] * per_minute),
+                tw_early=int(a * per_minute),
+                tw_late=int(b * per_minute),
+            )
+            for k, (a, b) in enumerate(instance.window_min)
+            if k
+        ],
+        [PyvrpDepot(location=0, tw_early=0, tw_late=horizon)],
+        [VehicleType(VANS, capacity=[int(instance.capacity)], fixed_cost=fixed, tw_late=horizon)],
+        [distance],
+        [distance],
+    )
+    result = solve(data, stop=MaxRuntime(time_limit_s), seed=1, display=False)
+    assert result.is_feasible()
+    return result.best.distance() / PYVRP_SCALE, result.best.num_routes()
+
+
+def solomon_table(budgets: tuple[float, ...] = (10.0, 60.0)) -> None:
+    rows = []
+    gaps: dict[tuple[float, bool], list[float]] = {}
+    for name, (best_distance, (best_vans, best_vans_distance)) in SOLOMON.items():
+        instance = solomon(name)
+        for budget in budgets:
+            for minimize in (False, True):
+                theirs, their_vans = pyvrp_solomon(instance, budget, minimize)
+                started = time.perf_counter()
+                ours = plan_fleet(solomon_problem(instance, budget, minimize))
+                elapsed = time.perf_counter() - started
+                distance = ours.distance_m / (instance.km_per_unit * 1000.0)
+                gap = (distance / theirs - 1) * 100
+                gaps.setdefault((budget, minimize), []).append(gap)
+                best = f"{best_vans}, {best_vans_distance}" if minimize else f"{best_distance}"
+                rows.append(
+                    [
+                        name,
+                        f"{budget:.0f} s",
+                        "vans, then distance" if minimize else "distance",
+                        f"{distance:.1f}",
+                        ours.vehicles_used,
+                        len(ours.unassigned),
+                        f"{theirs:.1f}",
+                        their_vans,
+                        f"{gap:+.2f} %",
+                        best,
+                        f"{elapsed:.1f}",
+                    ]
+                )
+    print_table(
+        "Solomon VRPTW (100 customers, 25 vans): coldroute vs PyVRP 0.14 on the same instance, "
+        "same budget, same run",
+        [
+            "instance",
             "budget",
             "objective",
             "ours",
@@ -139,10 +223,23 @@ def rc208_table() -> None:
             "PyVRP",
             "vans",
             "ours vs PyVRP",
+            "best known (vans, distance)",
             "our wall time [s]",
-            "verifications",
         ],
         rows,
+    )
+    print_table(
+        "Solomon: ours vs PyVRP's distance",
+        ["budget", "objective", "mean", "worst"],
+        [
+            [
+                f"{budget:.0f} s",
+                "vans, then distance" if minimize else "distance",
+                f"{np.mean(values):+.2f} %",
+                f"{max(values):+.2f} %",
+            ]
+            for (budget, minimize), values in gaps.items()
+        ],
     )
 
 
@@ -256,8 +353,95 @@ def battery_table() -> None:
     )
 
 
+def vienna_grid(n_stops: int, n_vans: int, time_limit_s: float) -> FleetProblem:
+    """``n_stops`` stops of 1 kg on a grid in central Vienna (60 s service, 30 s door), paper
+    vans with 40 kWh and 400 kg, shifts 06:30–16:30."""
+    rng = np.random.default_rng(3)
+    side = math.ceil(math.sqrt(n_stops))
+    stops = [
+        Stop(
+            id=f"s{k}",
+            lat=48.19 + (k // side) * 0.0009 + rng.normal() * 1e-4,
+            lon=16.35 + (k % side) * 0.0013 + rng.normal() * 1e-4,
+            service_time_s=60,
+            door_open_s=30,
+            delivery_kg=1.0,
+        )
+        for k in range(n_stops)
+    ]
+    van = (
+        PRESETS["paper-generic"]
+        .van()
+        .model_copy(
+            update={"battery": BatteryParams(usable_capacity_kwh=40.0), "payload_kg": 400.0}
+        )
+    )
+    return FleetProblem(
+        date=dt.date(2026, 5, 12),
+        timezone="Europe/Vienna",
+        depot=Depot(id="depot", lat=48.1703, lon=16.4207),
+        vehicles=[
+            FleetVehicle(id=f"v{k}", van=van, shift_start="06:30", shift_end="16:30")
+            for k in range(n_vans)
+        ],
+        stops=stops,
+        weather=Weather(t_min_c=12, t_max_c=22),
+        objective="distance",
+        time_limit_s=time_limit_s,
+    )
+
+
+def _scale_case(n_stops: int, n_vans: int, time_limit_s: float, out: Queue) -> None:
+    started = time.perf_counter()
+    result = plan_fleet(vienna_grid(n_stops, n_vans, time_limit_s))
+    elapsed = time.perf_counter() - started
+    reasons = sorted({u.reason for u in result.unassigned})
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    served = sum(len(r.plan.stops) for r in result.routes)
+    out.put(
+        [
+            n_stops,
+            n_vans,
+            f"{time_limit_s:.0f} s",
+            served,
+            result.vehicles_used,
+            ", ".join(reasons) or "—",
+            f"{elapsed:.1f}",
+            f"{peak_mb:.0f}",
+        ]
+    )
+
+
+def scale_table() -> None:
+    """Each case in a fresh process, so its peak memory is its own."""
+    rows = []
+    context = get_context("spawn")
+    for n_stops, n_vans, limit in ((200, 3, 10.0), (200, 100, 10.0), (1000, 50, 60.0)):
+        out = context.Queue()
+        process = context.Process(target=_scale_case, args=(n_stops, n_vans, limit, out))
+        process.start()
+        rows.append(out.get())
+        process.join()
+    print_table(
+        "Fleets at scale: stops of 1 kg on a grid in central Vienna, paper vans (40 kWh, 400 kg), "
+        "shifts 06:30–16:30",
+        [
+            "stops",
+            "vans",
+            "time limit",
+            "served",
+            "vans used",
+            "unassigned reasons",
+            "wall time [s]",
+            "peak memory [MB]",
+        ],
+        rows,
+    )
+
+
 def main() -> None:
-    rc208_table()
+    solomon_table()
+    scale_table()
     battery_table()
 
 

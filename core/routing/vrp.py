@@ -1,14 +1,22 @@
-"""Routes for several vans from one depot with OR-Tools' routing library: delivery time windows,
-shifts, payload and an energy budget per van (the dimensions), each van with its own costs.
+"""Routes for several vans from one depot: delivery time windows, shifts, payload and an energy
+budget per van, each van with its own costs.
 
 The solver sees integers only; the caller rounds explicitly: seconds for time, grams for
 payload, tenths of a watt-hour for energy, and the objective's own unit for the arc costs.
 A stop that no route can take is dropped for a penalty larger than any set of routes costs,
 so stops are dropped only when they cannot be served, never to save cost.
 
-The search is the routing library's: a first solution by the cheapest arc, then guided local
-search until the time limit, or until :data:`SOLUTIONS_PER_STOP` improving solutions per stop
-when that comes first (small fleets then end early, and deterministically).
+Two engines, each where it is strongest (``benchmarks/bench_fleet.py``):
+
+1. PyVRP's iterated local search (Wouda, Lan & Kool 2024) on windows, shifts and payload: on
+   Solomon's instances within a fraction of a percent of the best known routes. A stop with
+   several windows is a group of alternatives, one per window. It ends at the time limit or
+   after :data:`ITERATIONS_PER_STOP` iterations per stop without improvement, whichever
+   comes first (seeded: the same routes for the same input when it ends early).
+2. OR-Tools' routing library with every constraint as a dimension, the energy budget
+   included, and the cost of waiting for a window: it takes over PyVRP's routes when they
+   break an energy budget (less the stops that do not fit) or when waiting has a cost,
+   for the rest of the budget.
 """
 
 from __future__ import annotations
@@ -18,14 +26,20 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import pyvrp
 from numpy.typing import NDArray
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
+from pyvrp.stop import MaxRuntime, MultipleCriteria, NoImprovement
 
 IntMatrix = NDArray[np.int64]
 
+#: Iterations per stop without an improvement after which PyVRP ends before its time limit.
+ITERATIONS_PER_STOP = 200
 #: Solutions per stop after which guided local search ends before its time limit.
 SOLUTIONS_PER_STOP = 40
-#: The routing library overshoots its limit by a few milliseconds; it gets this much less [s].
+#: Share of the budget OR-Tools has to price the waits of PyVRP's routes.
+WAIT_POLISH_SHARE = 0.2
+#: The searches overshoot their limit by a few milliseconds; they get this much less [s].
 _STOP_MARGIN_S = 0.01
 
 
@@ -112,7 +126,188 @@ def solve_routes(
     initial
         Routes to start from (stops per van); ignored when they break a constraint.
     """
-    started = time.perf_counter()
+    deadline = time.perf_counter() + time_limit_s
+    waits_cost = any(v.wait_cost_per_s for v in problem.vehicles)
+    share = WAIT_POLISH_SHARE if waits_cost else 0.0
+    found = _pyvrp_routes(problem, deadline - time_limit_s * share, initial)
+    if found is not None and not waits_cost and not _over_energy(problem, found):
+        return RoutingOutcome(found)
+    start = (
+        initial if found is None else [_within_energy(problem, v, r) for v, r in enumerate(found)]
+    )
+    return _ortools_routes(problem, deadline, start)
+
+
+def route_energy(problem: RoutingInput, v: int, route: list[int]) -> int:
+    """Van ``v``'s energy on ``route`` by the solver's matrix (0 without a budget)."""
+    energy = problem.vehicles[v].energy
+    if energy is None:
+        return 0
+    order = [0, *route, 0]
+    return int(energy[order[:-1], order[1:]].sum())
+
+
+def _over_energy(problem: RoutingInput, routes: list[list[int]]) -> bool:
+    return any(
+        v.energy is not None and route_energy(problem, k, r) > v.energy_capacity
+        for k, (v, r) in enumerate(zip(problem.vehicles, routes, strict=True))
+    )
+
+
+def _within_energy(problem: RoutingInput, v: int, route: list[int]) -> list[int]:
+    """``route`` less its last stops until it fits van ``v``'s energy budget."""
+    capacity = problem.vehicles[v].energy_capacity
+    kept = list(route)
+    while (
+        kept
+        and route_energy(problem, v, kept) > capacity
+        and problem.vehicles[v].energy is not None
+    ):
+        kept.pop()
+    return kept
+
+
+@dataclass(frozen=True)
+class _PyvrpModel:
+    """The problem as PyVRP's data: each client's place, and the vans of each vehicle type."""
+
+    data: pyvrp.ProblemData
+    client_node: list[int]
+    node_clients: dict[int, list[int]]
+    type_vans: list[list[int]]
+
+
+def _kind(vehicle: VehicleSpec, minimize_fixed: bool) -> tuple[object, ...]:
+    return (
+        id(vehicle.arc_cost),
+        vehicle.payload_capacity_g,
+        vehicle.shift_s,
+        vehicle.fixed_cost if minimize_fixed else 0,
+    )
+
+
+def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
+    """Vans alike but for their order share a vehicle type (the search breaks the symmetry
+    itself; the first-listed vans get the routes); a place with several windows is a group of
+    clients, one per window, of which the route visits one."""
+    n = problem.travel_s.shape[0]
+    horizon = int(problem.horizon_s)
+    never = horizon + 1
+    locations = [pyvrp.Location(0.0, 0.0) for _ in range(n)]
+    clients: list[pyvrp.Client] = []
+    client_node: list[int] = []
+    node_clients: dict[int, list[int]] = {}
+    groups: list[pyvrp.ClientGroup] = []
+    for node in range(1, n):
+        windows = problem.windows_s[node] or [(0, horizon)]
+        if windows[0][0] >= never:  # no van can ever serve it: not in the model
+            continue
+        members = []
+        for opens, closes in windows:
+            members.append(len(clients))
+            clients.append(
+                pyvrp.Client(
+                    location=node,
+                    delivery=[int(problem.demand_g[node])],
+                    service_duration=int(problem.service_s[node]),
+                    tw_early=int(opens),
+                    tw_late=int(closes),
+                    prize=int(problem.drop_penalty),
+                    required=False,
+                    group=len(groups) if len(windows) > 1 else None,
+                )
+            )
+            client_node.append(node)
+        if len(windows) > 1:
+            groups.append(pyvrp.ClientGroup(members, required=False))
+        node_clients[node] = members
+    # A large fixed cost keeps vans home; a small one (the order of the vans) only breaks ties.
+    large_fixed = max((v.fixed_cost for v in problem.vehicles), default=0) > len(problem.vehicles)
+    kinds: dict[tuple[object, ...], list[int]] = {}
+    for v, vehicle in enumerate(problem.vehicles):
+        kinds.setdefault(_kind(vehicle, large_fixed), []).append(v)
+    matrices: dict[int, int] = {}
+    distance_matrices: list[IntMatrix] = []
+    vehicle_types = []
+    for vans in kinds.values():
+        vehicle = problem.vehicles[vans[0]]
+        key = id(vehicle.arc_cost)
+        if key not in matrices:
+            matrices[key] = len(distance_matrices)
+            distance_matrices.append(np.asarray(vehicle.arc_cost, dtype=np.int64))
+        first, last = (int(t) for t in vehicle.shift_s)
+        vehicle_types.append(
+            pyvrp.VehicleType(
+                num_available=len(vans),
+                capacity=[int(vehicle.payload_capacity_g)],
+                fixed_cost=int(vehicle.fixed_cost) if large_fixed else 0,
+                tw_early=first,
+                tw_late=last,
+                profile=matrices[key],
+            )
+        )
+    travel = np.asarray(problem.travel_s, dtype=np.int64)
+    data = pyvrp.ProblemData(
+        locations,
+        clients,
+        [pyvrp.Depot(location=0, tw_early=0, tw_late=horizon)],
+        vehicle_types,
+        distance_matrices,  # type: ignore[arg-type]  # PyVRP's stubs name ndarray[int]
+        [travel] * len(distance_matrices),  # type: ignore[list-item]
+        groups,
+    )
+    return _PyvrpModel(data, client_node, node_clients, list(kinds.values()))
+
+
+def _pyvrp_routes(
+    problem: RoutingInput, deadline: float, initial: list[list[int]] | None
+) -> list[list[int]] | None:
+    """PyVRP's best feasible routes per van by ``deadline``; None when it has none."""
+    model = _pyvrp_model(problem)
+    if not model.client_node:
+        return [[] for _ in problem.vehicles]
+    budget_s = deadline - time.perf_counter() - _STOP_MARGIN_S
+    if budget_s <= 0:
+        return None
+    patience = ITERATIONS_PER_STOP * len(model.node_clients)
+    stop = MultipleCriteria([MaxRuntime(budget_s), NoImprovement(patience)])
+    start = _pyvrp_start(model, initial)
+    result = pyvrp.solve(
+        model.data, stop=stop, seed=0, display=False, collect_stats=False, initial_solution=start
+    )
+    if not result.is_feasible():
+        return None
+    routes: list[list[int]] = [[] for _ in problem.vehicles]
+    taken = [0] * len(model.type_vans)
+    for route in result.best.routes():
+        kind = route.vehicle_type()
+        van = model.type_vans[kind][taken[kind]]
+        taken[kind] += 1
+        routes[van] = [model.client_node[a.idx] for a in route.schedule() if a.is_client()]
+    return routes
+
+
+def _pyvrp_start(model: _PyvrpModel, initial: list[list[int]] | None) -> pyvrp.Solution | None:
+    """``initial`` as a PyVRP solution (each stop in its first window); None without it."""
+    if initial is None:
+        return None
+    van_type = {van: kind for kind, vans in enumerate(model.type_vans) for van in vans}
+    routes = [
+        pyvrp.Route(
+            model.data,
+            [model.node_clients[node][0] for node in route if node in model.node_clients],
+            van_type[v],
+        )
+        for v, route in enumerate(initial)
+        if route
+    ]
+    return pyvrp.Solution(model.data, routes)
+
+
+def _ortools_routes(
+    problem: RoutingInput, deadline: float, initial: list[list[int]] | None
+) -> RoutingOutcome | None:
+    """OR-Tools' guided local search with every dimension, from ``initial`` when it holds."""
     manager, routing = _model(problem)
     params = pywrapcp.DefaultRoutingSearchParameters()
     params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.PATH_CHEAPEST_ARC
@@ -120,7 +315,7 @@ def solve_routes(
         routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
     )
     params.solution_limit = SOLUTIONS_PER_STOP * max(problem.travel_s.shape[0] - 1, 1)
-    budget_s = time_limit_s - (time.perf_counter() - started) - _STOP_MARGIN_S
+    budget_s = deadline - time.perf_counter() - _STOP_MARGIN_S
     params.time_limit.FromMilliseconds(max(int(budget_s * 1000), 1))
     routing.CloseModelWithParameters(params)
     solution = None
