@@ -40,15 +40,13 @@ _log = logging.getLogger("coldroute.requests")
 DESCRIPTION = """
 Route planning and energy simulation for **all-electric refrigerated delivery vans**.
 
-`POST /v1/plans` orders a round's stops with OR-Tools, simulates every leg with the
-drive-train, cab and refrigeration model of *"Wholistic simulation of an all-electric
-refrigerated delivery vehicle"* and says whether the battery holds out with its reserve.
-`POST /v1/fleet-plans` splits the day's stops across several vans with time windows,
-shifts, payload and each battery as constraints, and verifies every route by the full
-simulation.
-`POST /v1/simulate` gives the energy of one speed trace. Units are in the field names
-(`_m`, `_s`, `_kwh`, `_c`...). Errors are `application/problem+json` (RFC 9457).
-"""
+`POST /v1/plans` orders a round's stops (a local search, CP-SAT's proof), simulates every leg with
+the drive-train, cab and refrigeration model of *"Wholistic simulation of an all-electric
+refrigerated delivery vehicle"* and says whether the battery holds out with its reserve. `POST
+/v1/fleet-plans` splits the day's stops across several vans with time windows, shifts, payload and
+each battery as constraints, and verifies every route by the full simulation. `POST /v1/simulate`
+gives the energy of one speed trace. Units are in the field names (`_m`, `_s`, `_kwh`, `_c`...).
+Errors are `application/problem+json` (RFC 9457)."""
 
 
 class BodyLimit:

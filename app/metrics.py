@@ -53,7 +53,7 @@ class Metrics:
         )
         self.solve = Histogram(
             "coldroute_solve_seconds",
-            "Time the tour search took (OR-Tools), per plan.",
+            "Time the tour search took, per plan.",
             buckets=LATENCY_BUCKETS_S,
             registry=self.registry,
         )

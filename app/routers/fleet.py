@@ -36,10 +36,10 @@ async def create_fleet_plan(
     settings: SettingsDep,
     pool: ExecutorDep,
 ) -> FleetPlanResponse:
-    """Splits the stops across the vans (OR-Tools routing with time windows, shifts, payload
-    and each van's battery as constraints) and simulates every route's day in full: the charge
-    never falls below a van's reserve, service starts inside a window, every van is back
-    before its shift ends, deliveries fit the payload. A route the simulation rejects is
+    """Splits the stops across the vans (PyVRP's search, OR-Tools' where the battery binds; time
+    windows, shifts, payload and each van's battery as constraints) and simulates every route's day
+    in full: the charge never falls below a van's reserve, service starts inside a window, every van
+    is back before its shift ends, deliveries fit the payload. A route the simulation rejects is
     tightened and solved again within `time_limit_s`; stops no van can serve are listed in
     `unassigned` with their reason. Solved in a worker process, as plans are."""
     result = await pool.run(run_fleet_plan, request, settings, disconnected=http.is_disconnected)

@@ -71,10 +71,11 @@ async def create_plan(
         Header(description="application/json (default) or application/geo+json for a map."),
     ] = None,
 ) -> Any:
-    """Orders the stops (OR-Tools), simulates every leg and stop with the paper's model and says
-    whether the battery holds out. With `COLDROUTE_OSRM_URL` set, distances, durations and each
-    leg's speed profile come from the OSRM road router. Solved in a worker process; when every
-    worker is busy the request waits in a bounded queue (503 with Retry-After beyond it)."""
+    """Orders the stops (a local search, CP-SAT's proof), simulates every leg and stop with the
+    paper's model and says whether the battery holds out. With `COLDROUTE_OSRM_URL` set, distances,
+    durations and each leg's speed profile come from the OSRM road router. Solved in a worker
+    process; when every worker is busy the request waits in a bounded queue (503 with Retry-After
+    beyond it)."""
     result = await pool.run(run_plan, request, settings, disconnected=http.is_disconnected)
     http.app.state.metrics.solve.observe(result.solved.runtime_s)
     if wants_geojson(accept):
