@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+from core.routing.tsp import prepare as prepare_search
 from tests.weather_stub import StubServer
 from tools import osrm
 
@@ -26,6 +27,13 @@ if os.environ.get("CI"):
     settings.load_profile("ci")
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "reference"
+
+
+@pytest.fixture(scope="session", autouse=True)
+def compiled_search() -> None:
+    """The round trip's compiled search loaded before any test times a solve, as the
+    server's workers load it at start."""
+    prepare_search()
 
 
 @pytest.fixture(scope="session")

@@ -20,6 +20,7 @@ from app.schemas.studies import (
     SpeedSweepResponse,
 )
 from app.settings import Settings
+from core.routing.tsp import prepare as prepare_search
 
 RequestT = TypeVar("RequestT", bound=BaseModel)
 ResultT = TypeVar("ResultT")
@@ -95,7 +96,9 @@ JOB_KINDS: dict[str, JobKind[Any, Any]] = {
 
 
 def loaded() -> None:
-    """Nothing: a worker process that runs it has imported every operation (a warm-up)."""
+    """A worker process that runs it has imported every operation and loaded the compiled
+    round-trip search (a warm-up)."""
+    prepare_search()
 
 
 def run_job(kind: str, request: dict[str, Any], settings: Settings) -> dict[str, Any]:

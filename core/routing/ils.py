@@ -13,7 +13,8 @@ prefix sums of the tour's arcs each way). Each kick, a double bridge (Martin, Ot
 their direction (so it suits one-way streets too); the local search repairs the six places it
 touched, and the result is kept when it is no longer than before. Tens of thousands of kicks
 per second on delivery rounds, where Python would manage a few hundred. Numba compiles it once
-per installation (about 10 s, cached beside the module or in the user's cache).
+per installation (about 10 s, cached beside the module or in the user's cache) and loads it in
+about a second per process: :func:`warm_up`.
 
 The depot stays at position 0: every move leaves it there.
 """
@@ -291,15 +292,12 @@ def _kicks(
     return current, improved
 
 
-def _warm_up() -> None:
-    """Load (or, once per installation, compile) the compiled search at import, so that no
-    request's time limit pays for it."""
+def warm_up() -> None:
+    """Load (or, once per installation, compile) the compiled search: about a second with
+    Numba's import, so a process that will solve does it before its first time limit."""
     rng = np.random.default_rng(0)
     cost = rng.integers(1, 100, size=(8, 8)).astype(np.int64)
     near = neighbours(cost)
     tour = _local_search_all(cost, np.arange(8, dtype=np.int64), near)
     _kicks(cost, tour, near, 1, 0)
     _length(cost, tour)
-
-
-_warm_up()

@@ -33,7 +33,6 @@ from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 from ortools.sat.python import cp_model
 
 from core.exceptions import InvalidParameterError
-from core.routing.ils import iterated_local_search
 
 SolverStatus = Literal["optimal", "feasible", "fixed_order"]
 #: Rounds up to this many nodes (depot included) are proven on the full graph from
@@ -130,9 +129,19 @@ def solve_tour(
     return done(_improve(cost, best, deadline), "feasible")
 
 
+def prepare() -> None:
+    """Load the compiled local search now (about a second, once per process), not in the first
+    round of more than :data:`FULL_GRAPH_MAX_NODES` places: what worker processes do first."""
+    from core.routing import ils  # Numba's import is heavy: only processes that solve pay it
+
+    ils.warm_up()
+
+
 def _improve(cost: NDArray[np.int64], start: list[int], deadline: float) -> list[int]:
     """The best of :data:`RUNS` local searches from ``start``, sharing the time to
     ``deadline`` (a ``time.perf_counter`` value); ``start`` if no time is left."""
+    from core.routing.ils import iterated_local_search
+
     best = start
     for run in range(RUNS):
         remaining = deadline - time.perf_counter()

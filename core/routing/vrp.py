@@ -132,10 +132,19 @@ def solve_routes(
     found = _pyvrp_routes(problem, deadline - time_limit_s * share, initial)
     if found is not None and not waits_cost and not _over_energy(problem, found):
         return RoutingOutcome(found)
-    start = (
-        initial if found is None else [_within_energy(problem, v, r) for v, r in enumerate(found)]
-    )
-    return _ortools_routes(problem, deadline, start)
+    if found is None:
+        return _ortools_routes(problem, deadline, initial)
+    fitting = [_within_energy(problem, v, r) for v, r in enumerate(found)]
+    polished = _ortools_routes(problem, deadline, fitting)
+    # OR-Tools may find less in what is left of the budget (or reject the start and begin
+    # afresh): PyVRP's routes, trimmed, hold.
+    if polished is None or _served(polished.routes) < _served(fitting):
+        return RoutingOutcome(fitting)
+    return polished
+
+
+def _served(routes: list[list[int]]) -> int:
+    return sum(len(route) for route in routes)
 
 
 def route_energy(problem: RoutingInput, v: int, route: list[int]) -> int:
