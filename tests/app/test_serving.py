@@ -29,6 +29,20 @@ def post(url: str, body: dict, timeout: float = 60) -> httpx.Response:
     return httpx.post(f"{url}/v1/plans", json=body, timeout=timeout)
 
 
+def workers_detail(url: str) -> str:
+    checks = httpx.get(f"{url}/readyz", timeout=5).json()["checks"]
+    return next(c["detail"] for c in checks if c["name"] == "workers")
+
+
+def wait_until(url: str, words: str, timeout_s: float = 10.0) -> None:
+    """Until readiness's workers check says ``words`` (e.g. "1 busy"): a loaded machine may
+    take longer than a fixed sleep to hand a request to its worker."""
+    deadline = time.monotonic() + timeout_s
+    while words not in workers_detail(url):
+        assert time.monotonic() < deadline, f"never {words!r}: {workers_detail(url)}"
+        time.sleep(0.05)
+
+
 def test_liveness_answers_while_every_worker_solves(server):
     # Two 300-stop rounds of up to 6 s each (the search may stall sooner) keep both workers
     # (both cores) busy.
@@ -107,9 +121,9 @@ def test_readiness_names_what_is_down(server):
 def test_sigterm_refuses_new_work_finishes_what_runs_and_exits_in_time(server):
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         running = pool.submit(post, server.url, long_plan(300, 3))
-        time.sleep(1.0)
+        wait_until(server.url, "1 busy")
         waiting = pool.submit(post, server.url, long_plan(8, 0.1))
-        time.sleep(0.3)
+        wait_until(server.url, "1 waiting")
         signalled = time.monotonic()
         server.process.send_signal(signal.SIGTERM)
         time.sleep(0.3)
