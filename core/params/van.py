@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, ValidationInfo, field_validator
+from pydantic import Field, ValidationError, ValidationInfo, field_validator
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from core.params.base import Params
 
@@ -306,6 +307,30 @@ class CargoBoxParams(Params):
 MIN_SOC_WINDOW = 0.01
 
 
+class ChargingPoint(Params):
+    """One point of a charging curve: the power the battery takes at a state of charge."""
+
+    soc: float = Field(..., ge=0, le=1, description="State of charge [–], 0–1.")
+    power_kw: float = Field(
+        ..., gt=0, le=1000, description="Charging power drawn from the charger here [kW]."
+    )
+
+
+#: Where the default charging curve begins to taper [–] and the share of the van's maximum
+#: power it reaches at full: lithium-ion cells charge at constant current to about 80 %,
+#: then at constant voltage with a falling current (CC-CV).
+TAPER_SOC = 0.8
+FULL_POWER_SHARE = 0.2
+
+
+def _point_error(k: int, name: str, rule: str, value: float) -> None:
+    """Raise the rule a charging curve's point ``k`` breaks, located at its field ``name``."""
+    error = PydanticCustomError("charging_curve", rule, {"previous": k - 1, "value": f"{value:g}"})
+    raise ValidationError.from_exception_data(
+        "ChargingPoint", [InitErrorDetails(type=error, loc=(k, name), input=None)]
+    )
+
+
 class BatteryParams(Params):
     """Traction battery as seen by the energy balance."""
 
@@ -329,6 +354,44 @@ class BatteryParams(Params):
         description="Energy stored per energy drawn from the grid when charging [–]; sets the "
         "energy to recharge at the plug.",
     )
+    max_charge_power_kw: float = Field(
+        50.0,
+        gt=0,
+        le=1000,
+        description="Most power the van takes from a charger [kW] (its on-board AC charger or "
+        "its DC inlet); caps every charger and the charging curve.",
+    )
+    charging_curve: list[ChargingPoint] | None = Field(
+        None,
+        min_length=2,
+        max_length=50,
+        description="Charging power by state of charge: points of `soc` (increasing) and "
+        "`power_kw` (non-increasing), linear between, the first point's power below it and "
+        "the last's above. Null: max_charge_power_kw up to 80 % (CC), then falling linearly "
+        "to 20 % of it at full (CV).",
+    )
+    charge_to_full: bool = Field(
+        False,
+        description="Charge to full at every charge. False: charge what the rest of the day "
+        "needs, with its reserve and a margin (partial recharge).",
+    )
+
+    @field_validator("charging_curve")
+    @classmethod
+    def _curve_tapers(cls, value: list[ChargingPoint] | None) -> list[ChargingPoint] | None:
+        for k in range(1, len(value or ())):
+            previous, point = value[k - 1], value[k]  # type: ignore[index]
+            if point.soc <= previous.soc:
+                _point_error(k, "soc", "must be above point {previous}'s ({value})", previous.soc)
+            if point.power_kw > previous.power_kw:
+                _point_error(
+                    k,
+                    "power_kw",
+                    "must not be above point {previous}'s ({value}): the charging power does "
+                    "not rise with the soc",
+                    previous.power_kw,
+                )
+        return value
 
     @field_validator("min_soc")
     @classmethod

@@ -1,0 +1,93 @@
+"""Charging curve, charge times and partial charges against hand calculations
+(core/physics/charging.py's closed forms: t = C/η·∫ds/P(s))."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from core.exceptions import InvalidParameterError
+from core.params import BatteryParams
+from core.physics.charging import charge_curve
+
+KWH = 3.6e6
+#: 40 kWh, 90 % charging efficiency, 50 kW van, default curve (flat to 80 %, 10 kW at full).
+BATTERY = BatteryParams(usable_capacity_kwh=40.0, charging_efficiency=0.9)
+
+
+def test_a_22_kw_charger_caps_the_curve_until_the_taper_falls_below_it():
+    curve = charge_curve(BATTERY, 22_000.0)
+    # 50 − 40·(s − 0.8)/0.2 = 22 kW at s = 0.94: flat 22 kW up to there, then 22 → 10 kW.
+    assert curve.soc.tolist() == pytest.approx([0.0, 0.8, 0.94, 1.0])
+    assert curve.power_w.tolist() == pytest.approx([22e3, 22e3, 22e3, 10e3])
+    # 0.20 → 0.94 at 22 kW: 0.74 · 40 kWh / (0.9 · 22 kW) = 5381.8 s.
+    flat_s = 0.74 * 40 * KWH / (0.9 * 22e3)
+    assert curve.time_s(0.2, 0.94) == pytest.approx(flat_s, rel=1e-9)
+    # 0.94 → 1.00 tapering 22 → 10 kW: 0.06/(10 − 22 kW) · ln(10/22) · C/η = 630.8 s.
+    taper_s = 0.06 / (10e3 - 22e3) * math.log(10 / 22) * 40 * KWH / 0.9
+    assert taper_s == pytest.approx(630.8, abs=0.1)
+    assert curve.time_s(0.2, 1.0) == pytest.approx(flat_s + taper_s, rel=1e-9)
+
+
+def test_a_fast_charger_is_capped_by_the_van_and_slows_past_80_percent():
+    curve = charge_curve(BATTERY, 150_000.0)
+    assert curve.power_at_w([0.5, 0.8, 0.9, 1.0]).tolist() == pytest.approx(
+        [50e3, 50e3, 30e3, 10e3]
+    )
+    # 10 % → 80 %: 0.7 · 40 kWh / (0.9 · 50 kW) = 2240 s; 80 → 90 %: 50 → 30 kW.
+    assert curve.time_s(0.1, 0.8) == pytest.approx(2240.0, rel=1e-9)
+    taper = 0.1 / (30e3 - 50e3) * math.log(30 / 50) * 40 * KWH / 0.9
+    assert curve.time_s(0.8, 0.9) == pytest.approx(taper, rel=1e-9)
+    # the same 10 % of charge takes longer above 80 % than below
+    assert curve.time_s(0.8, 0.9) > curve.time_s(0.6, 0.7)
+
+
+def test_soc_after_inverts_the_charge_time_and_stops_at_full():
+    curve = charge_curve(BATTERY, 22_000.0)
+    times = np.array([0.0, 600.0, curve.time_s(0.3, 0.94), curve.time_s(0.3, 0.99), 1e6])
+    after = curve.soc_after(0.3, times)
+    # 600 s at 22 kW stores 0.9 · 22 kW · 600 s = 3.3 kWh: 0.3 + 3.3/40 = 0.3825.
+    assert after.tolist() == pytest.approx([0.3, 0.3825, 0.94, 0.99, 1.0], rel=1e-9)
+    assert curve.stored_j(0.3, 600.0) == pytest.approx(3.3 * KWH, rel=1e-9)
+
+
+def test_an_own_curve_is_held_flat_beyond_its_points():
+    battery = BatteryParams(
+        usable_capacity_kwh=40.0,
+        charging_efficiency=0.9,
+        charging_curve=[
+            {"soc": 0.2, "power_kw": 40.0},
+            {"soc": 0.6, "power_kw": 40.0},
+            {"soc": 0.9, "power_kw": 20.0},
+        ],
+    )
+    curve = charge_curve(battery, 100_000.0)
+    assert curve.power_at_w([0.0, 0.2, 0.75, 0.95]).tolist() == pytest.approx(
+        [40e3, 40e3, 30e3, 20e3]
+    )
+    # 0.9 → 1.0 at the last point's 20 kW: 0.1 · 40 kWh / (0.9 · 20 kW) = 800 s.
+    assert curve.time_s(0.9, 1.0) == pytest.approx(800.0, rel=1e-9)
+
+
+def test_a_colder_day_has_less_to_fill():
+    full = charge_curve(BATTERY, 22_000.0)
+    derated = charge_curve(BATTERY, 22_000.0, usable_share=0.9)
+    assert derated.time_s(0.2, 0.8) == pytest.approx(0.9 * full.time_s(0.2, 0.8), rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("curve", "where"),
+    [
+        ([{"soc": 0.0, "power_kw": 20}, {"soc": 0.8, "power_kw": 30}], ".1.power_kw"),
+        ([{"soc": 0.5, "power_kw": 20}, {"soc": 0.5, "power_kw": 10}], ".1.soc"),
+        ([{"soc": 0.0, "power_kw": 20}, {"soc": 1.2, "power_kw": 10}], ".1.soc"),
+        ([{"soc": 0.0, "power_kw": 0}, {"soc": 1.0, "power_kw": 5}], ".0.power_kw"),
+        ([{"soc": 0.0, "power_kw": 20}], ""),
+    ],
+)
+def test_a_curve_that_rises_or_leaves_0_to_1_is_refused_naming_the_point(curve, where):
+    with pytest.raises(InvalidParameterError) as raised:
+        BatteryParams(charging_curve=curve)
+    assert raised.value.field == f"charging_curve{where}"
