@@ -52,6 +52,14 @@ class DoorOpening(Interval):
     duration_s: float = Field(..., ge=0, le=86_400, description="How long it stays open [s].")
 
 
+class ChargingSpell(Interval):
+    """A spell plugged in at a charger during a simulated trace (the van stands)."""
+
+    power_kw: float = Field(
+        ..., gt=0, le=1000, description="The charger's power [kW]; the van's curve caps it."
+    )
+
+
 #: Lightest and densest traffic ε_t [–]: the traffic law t_0 = t_p·(1 − ε_t)/ε_t needs
 #: ε_t strictly inside 0..1; beyond these it is constant speed or stop-and-go already.
 MIN_TRAFFIC_DENSITY = 0.01

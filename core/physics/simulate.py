@@ -10,7 +10,7 @@ from __future__ import annotations
 import datetime as dt
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -19,10 +19,11 @@ from numpy.typing import ArrayLike
 from core.arrays import FloatArray, interval_rates, uniform_interp
 from core.clock import SECONDS_PER_DAY, check_representable, local_clock
 from core.exceptions import InvalidParameterError
-from core.params import DoorOpening, Interval, Location, VanParams, Weather
+from core.params import ChargingSpell, DoorOpening, Interval, Location, VanParams, Weather
 from core.physics import battery as battery_model
 from core.physics.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
 from core.physics.cargo import BoxResult, precondition_energy_j, refrigeration
+from core.physics.charging import WATTS_PER_KW, charge_curve
 from core.physics.cycles import trace_distance_m
 from core.physics.motor import power_limited
 from core.physics.solar import (
@@ -94,6 +95,8 @@ class SimulationResult:
         Where the weather came from.
     warnings
         What the simulation had to change (a motor's cap the trace asked too much of).
+    charges
+        What each charging spell did, in the order given.
     """
 
     time_s: FloatArray
@@ -112,6 +115,20 @@ class SimulationResult:
     weather_days: list[DayWeather]
     weather_source: WeatherSource
     warnings: list[str]
+    charges: list[ChargeOutcome] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class ChargeOutcome:
+    """One spell at a charger: the state of charge before and after [–], the energy stored
+    in the battery and drawn from the grid for it [J] (``stored / charging_efficiency``), and
+    what the consumers took from the grid meanwhile [J]."""
+
+    soc_before: float
+    soc_after: float
+    stored_j: float
+    charge_grid_j: float
+    consumers_grid_j: float
 
 
 def _per_step(
@@ -194,6 +211,7 @@ def simulate(
     door_openings: Sequence[DoorOpening] = (),
     parked: Sequence[Interval] = (),
     heading_deg: ArrayLike | None = None,
+    charging: Sequence[ChargingSpell] = (),
 ) -> SimulationResult:
     """Simulate every consumer of the van along one speed trace (paper Fig. 7, one leg).
 
@@ -225,19 +243,25 @@ def simulate(
     heading_deg
         Direction of travel at each sample [°, 0 north, 90 east] for the wind; NaN or None
         where unknown.
+    charging
+        When the van is plugged in, seconds after start, and the charger's power: the battery
+        charges along its curve (:mod:`core.physics.charging`) and every consumer runs from
+        the grid meanwhile.
 
     Returns
     -------
     SimulationResult
     """
-    trace = _driven(van, speed_mps, dt_s, grade, payload_kg, door_openings, parked, heading_deg)
+    trace = _driven(
+        van, speed_mps, dt_s, grade, payload_kg, door_openings, parked, heading_deg, charging
+    )
     speed, n = trace.speed, trace.speed.size
     end_s = (n - 1) * dt_s
     check_representable(start, end_s)
     time_s = np.arange(n) * dt_s
     outside = _environment(start, location, van, weather, n - 1, dt_s)
     power, box, cab_gap_j = _consumers(van, trace, dt_s, outside)
-    soc, verdict, loss_j = _battery(van, power, dt_s, outside)
+    soc, verdict, loss_j, charges = _battery(van, power, dt_s, outside, trace.charging)
     grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c)
     return SimulationResult(
         time_s=time_s,
@@ -256,6 +280,7 @@ def simulate(
         weather_days=outside.days,
         weather_source=outside.source,
         warnings=trace.warnings,
+        charges=charges,
     )
 
 
@@ -270,6 +295,7 @@ class _Trace:
     door_openings: Sequence[DoorOpening]
     parked: Sequence[Interval]
     warnings: list[str]
+    charging: Sequence[ChargingSpell] = ()
 
 
 def _driven(
@@ -281,6 +307,7 @@ def _driven(
     door_openings: Sequence[DoorOpening],
     parked: Sequence[Interval],
     heading_deg: ArrayLike | None,
+    charging: Sequence[ChargingSpell] = (),
 ) -> _Trace:
     """The inputs checked, and the trace the van drives: the one asked for, or — when it asks
     for more than the motor's cap — the slower one the van can drive
@@ -291,12 +318,14 @@ def _driven(
     payload = van.payload_kg if payload_kg is None else payload_kg
     grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
     payload_step = _per_step(payload, n, "payload_kg", 0.0, 40_000.0)
-    _check_within((n - 1) * dt_s, door_openings=door_openings, parked=parked)
+    _check_within((n - 1) * dt_s, door_openings=door_openings, parked=parked, charging=charging)
     retimed = power_limited(
         van.vehicle, speed, dt_s, van.vehicle.mass_kg + payload_step, grade_step
     )
     if retimed is None:
-        return _Trace(speed, grade_step, payload_step, heading_deg, door_openings, parked, [])
+        return _Trace(
+            speed, grade_step, payload_step, heading_deg, door_openings, parked, [], charging
+        )
     m = retimed.speed_mps.size
     at = retimed.original_s / dt_s  # where each new sample lies in the original's samples
 
@@ -323,6 +352,7 @@ def _driven(
             f"the motor's {cap_kw:g} kW cap cannot follow the trace: the van drives it "
             f"{retimed.lost_s:,.0f} s slower (the same distance, the energy delivered later)"
         ],
+        [moved(c) for c in charging],
     )
 
 
@@ -360,15 +390,44 @@ def _consumers(
 
 
 def _battery(
-    van: VanParams, power_w: dict[str, FloatArray], dt_s: float, outside: _Environment
-) -> tuple[FloatArray, battery_model.BatteryVerdict, float]:
-    """The state of charge at every sample, the verdict, and the battery's own loss in the
-    cold or heat [J]."""
+    van: VanParams,
+    power_w: dict[str, FloatArray],
+    dt_s: float,
+    outside: _Environment,
+    charging: Sequence[ChargingSpell],
+) -> tuple[FloatArray, battery_model.BatteryVerdict, float, list[ChargeOutcome]]:
+    """The state of charge at every sample, the verdict, the battery's own loss in the cold
+    or heat [J], and what each charging spell did. Plugged in, the consumers run from the grid
+    and the battery charges along its curve from the state of charge it arrived with."""
     consumer_j = sum(power_w.values(), np.zeros(outside.ambient_c.size)) * dt_s
     drawn_j = battery_model.battery_energy_j(van.battery, consumer_j, outside.ambient_c)
     usable_share = battery_model.capacity_factor(van.battery, outside.start_c)
+    charges = []
+    for spell in sorted(charging, key=lambda c: c.start_s):
+        first = min(round(spell.start_s / dt_s), drawn_j.size)
+        last = min(round((spell.start_s + spell.duration_s) / dt_s), drawn_j.size)
+        grid_loads_j = float(consumer_j[first:last].sum())
+        drawn_j[first:last] = 0.0
+        before = battery_model.discharge(van.battery, drawn_j[:first], usable_share)[0][-1]
+        curve = charge_curve(van.battery, spell.power_kw * WATTS_PER_KW, usable_share)
+        reached = curve.soc_after(float(before), np.arange(0, last - first + 1) * dt_s)
+        drawn_j[first:last] = -np.diff(reached) * curve.capacity_j
+        stored_j = float((reached[-1] - reached[0]) * curve.capacity_j)
+        charges.append(
+            ChargeOutcome(
+                soc_before=float(before),
+                soc_after=float(reached[-1]),
+                stored_j=stored_j,
+                charge_grid_j=stored_j / van.battery.charging_efficiency,
+                consumers_grid_j=grid_loads_j,
+            )
+        )
     soc, verdict = battery_model.discharge(van.battery, drawn_j, usable_share)
-    return soc, verdict, float((drawn_j - consumer_j).sum())
+    charged_j = sum(c.stored_j for c in charges)
+    loss_j = (
+        float((drawn_j - consumer_j).sum()) + charged_j + sum(c.consumers_grid_j for c in charges)
+    )
+    return soc, verdict, loss_j, charges
 
 
 def _cabin_power_w(

@@ -3,16 +3,20 @@
 
 from __future__ import annotations
 
+import datetime as dt
 import math
+from zoneinfo import ZoneInfo
 
 import numpy as np
 import pytest
 
 from core.exceptions import InvalidParameterError
-from core.params import BatteryParams
+from core.params import BatteryParams, ChargingSpell, Interval, Location, VanParams, Weather
 from core.physics.charging import charge_curve
+from core.physics.simulate import simulate
 
 KWH = 3.6e6
+VIENNA = Location(lat=48.21, lon=16.37)
 #: 40 kWh, 90 % charging efficiency, 50 kW van, default curve (flat to 80 %, 10 kW at full).
 BATTERY = BatteryParams(usable_capacity_kwh=40.0, charging_efficiency=0.9)
 
@@ -91,3 +95,46 @@ def test_a_curve_that_rises_or_leaves_0_to_1_is_refused_naming_the_point(curve, 
     with pytest.raises(InvalidParameterError) as raised:
         BatteryParams(charging_curve=curve)
     assert raised.value.field == f"charging_curve{where}"
+
+
+def test_a_plugged_in_spell_charges_along_the_curve_while_the_consumers_run_from_the_grid():
+    van = VanParams(battery=BatteryParams(usable_capacity_kwh=40.0, initial_soc=0.5))
+    start = dt.datetime(2026, 7, 15, 12, 0, tzinfo=ZoneInfo("Europe/Vienna"))
+    spell = ChargingSpell(start_s=600.0, duration_s=1800.0, power_kw=22.0)
+    standing = dict(
+        weather=Weather(t_min_c=20, t_max_c=31),
+        parked=[Interval(start_s=0.0, duration_s=3600.0)],
+    )
+    plugged = simulate(np.zeros(3601), 1.0, start, VIENNA, van, charging=[spell], **standing)
+    unplugged = simulate(np.zeros(3601), 1.0, start, VIENNA, van, **standing)
+    load_j = sum(unplugged.power_w.values())  # the same consumers either way
+    assert sum(plugged.power_w.values()) == pytest.approx(load_j)
+    capacity_j = 40 * KWH
+    before = 0.5 - load_j[:600].sum() / capacity_j
+    # 1800 s at 22 kW, 90 % stored: 9.9 kWh, all below 80 % (no taper): +0.2475.
+    after = before + 0.9 * 22e3 * 1800 / capacity_j
+    charge = plugged.charges[0]
+    assert charge.soc_before == pytest.approx(before, rel=1e-9)
+    assert charge.soc_after == pytest.approx(after, rel=1e-9)
+    assert charge.stored_j == pytest.approx(9.9 * KWH, rel=1e-9)
+    assert charge.charge_grid_j == pytest.approx(11.0 * KWH, rel=1e-9)
+    assert charge.consumers_grid_j == pytest.approx(load_j[600:2400].sum(), rel=1e-9)
+    assert plugged.soc[2400] == pytest.approx(after, rel=1e-9)
+    assert plugged.soc[-1] == pytest.approx(after - load_j[2400:].sum() / capacity_j, rel=1e-9)
+    assert unplugged.soc[-1] == pytest.approx(0.5 - load_j.sum() / capacity_j, rel=1e-9)
+
+
+def test_a_long_spell_fills_the_battery_through_the_taper_and_no_further():
+    van = VanParams(battery=BatteryParams(usable_capacity_kwh=40.0, initial_soc=0.7))
+    start = dt.datetime(2026, 4, 15, 10, 0, tzinfo=ZoneInfo("Europe/Vienna"))
+    spell = ChargingSpell(start_s=0.0, duration_s=7200.0, power_kw=150.0)
+    result = simulate(np.zeros(7201), 1.0, start, VIENNA, van, charging=[spell])
+    curve = charge_curve(van.battery, 150e3)
+    full_s = curve.time_s(0.7, 1.0)
+    # 0.7 → 0.8 at 50 kW: 0.1·40 kWh/(0.9·50 kW) = 320 s; 0.8 → 1.0 tapering 50 → 10 kW
+    assert full_s == pytest.approx(
+        320.0 + 0.2 / (10e3 - 50e3) * math.log(10 / 50) * 40 * KWH / 0.9, rel=1e-9
+    )
+    assert result.soc[round(full_s) + 1] == pytest.approx(1.0)
+    assert result.charges[0].soc_after == pytest.approx(1.0)
+    assert result.charges[0].stored_j == pytest.approx(0.3 * 40 * KWH, rel=1e-9)
