@@ -56,7 +56,7 @@ from core.routing.roads import RememberingRouter, RoadRouter
 from core.routing.vrp import solve_routes
 
 #: Share of the remaining budget one solve may take (the rest verifies and re-solves).
-SOLVE_SHARE = 0.9
+SOLVE_SHARE = 0.95
 #: Budget below which no new solve starts [s].
 MIN_SOLVE_S = 0.05
 #: A tightened energy budget is cut this much below the simulated need, so the next
