@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 # A morning round in Vienna: depot in Simmering, eight grocery and pharmacy stops.
@@ -40,6 +41,41 @@ PLAN_EXAMPLE: dict[str, Any] = {
     "weather": {"t_min_c": 18, "t_max_c": 31},
     "driver_aggressiveness": 0.5,
     "objective": "energy",
+}
+
+# A long summer day of one van: 40 stops spread over 15 km around the centre (a golden-angle
+# spiral), about 60 kWh with the refrigeration at 31 °C — more than its 40 kWh. The depot's
+# 22 kW charger brings it back at noon to charge what the afternoon needs.
+_GOLDEN_ANGLE = math.pi * (3 - math.sqrt(5))
+CHARGING_PLAN_EXAMPLE: dict[str, Any] = {
+    "date": "2026-07-15",
+    "start_time": "07:00",
+    "timezone": "Europe/Vienna",
+    "depot": {
+        "id": "depot-centre",
+        "lat": 48.21,
+        "lon": 16.37,
+        "charger": {"power_kw": 22, "points": 1, "price_per_kwh": 0.3, "plug_minutes": 2},
+    },
+    "stops": [
+        {
+            "id": f"shop-{k + 1:02d}",
+            "lat": round(
+                48.21 + 15_000 * math.sqrt((k + 8) / 48) * math.sin(k * _GOLDEN_ANGLE) / 111_000, 5
+            ),
+            "lon": round(
+                16.37 + 15_000 * math.sqrt((k + 8) / 48) * math.cos(k * _GOLDEN_ANGLE) / 74_000, 5
+            ),
+            "service_time_s": 600,
+            "door_open_s": 180,
+            "delivery_kg": 8,
+        }
+        for k in range(40)
+    ],
+    "vehicle": {"preset": "paper-generic"},
+    "payload_kg": 400,
+    "battery": {"usable_capacity_kwh": 40, "initial_soc": 1.0, "min_soc": 0.1},
+    "weather": {"t_min_c": 21, "t_max_c": 31},
 }
 
 # The same day's stops for a fleet of two, with the shops' receiving windows: the bakery café

@@ -19,7 +19,7 @@ import httpx
 import numpy as np
 
 from core.exceptions import InvalidStopsError, NoRouteError, ServiceUnavailableError
-from core.params import Depot
+from core.params import Place
 from core.routing.roads import LegRoute, RoadTable, bearing_deg
 
 SERVICE = "osrm"
@@ -80,7 +80,7 @@ class OsrmRouter:
             )
         return body
 
-    def table(self, places: Sequence[Depot]) -> RoadTable:
+    def table(self, places: Sequence[Place]) -> RoadTable:
         """Distances [m] and durations [s] of every ordered pair, and each place's snap
         distance [m]."""
         n = len(places)
@@ -115,7 +115,7 @@ class OsrmRouter:
 
     def _fill(
         self,
-        places: Sequence[Depot],
+        places: Sequence[Place],
         rows: range,
         cols: range,
         distance: np.ndarray,
@@ -157,7 +157,7 @@ class OsrmRouter:
         duration[np.ix_(list(rows), list(cols))] = t
         snap[list(rows)] = snapped
 
-    def route(self, origin: Depot, destination: Depot) -> LegRoute:
+    def route(self, origin: Place, destination: Place) -> LegRoute:
         """The road from ``origin`` to ``destination``, segment by segment."""
         coordinates = (
             f"{origin.lon:.6f},{origin.lat:.6f};{destination.lon:.6f},{destination.lat:.6f}"

@@ -9,6 +9,7 @@ from app.operations.answers import attribution, battery, box, energy, weather
 from app.operations.limits import check_round, time_limit_s
 from app.schemas.base import EnergyShare, LineString, Point
 from app.schemas.plans import (
+    ChargeOut,
     Feature,
     LegOut,
     PlanFeatureCollection,
@@ -65,6 +66,7 @@ def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanRes
         tour=result.tour,
         legs=legs,
         stops=stops,
+        charges=[ChargeOut(**vars(charge)) for charge in result.charges],
         totals=Totals(
             distance_m=result.distance_m,
             duration_s=result.duration_s,

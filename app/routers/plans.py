@@ -8,7 +8,7 @@ from fastapi import APIRouter, Body, Header, Request
 from fastapi.responses import JSONResponse
 
 from app.deps import ExecutorDep, SettingsDep
-from app.examples import PLAN_EXAMPLE
+from app.examples import CHARGING_PLAN_EXAMPLE, PLAN_EXAMPLE
 from app.operations.plan import plan_geojson, plan_response, run_plan
 from app.schemas.plans import PlanRequest, PlanResponse
 
@@ -59,7 +59,11 @@ async def create_plan(
                 "vienna-8-stops": {
                     "summary": "A summer morning round in Vienna",
                     "value": PLAN_EXAMPLE,
-                }
+                },
+                "vienna-40-stops-depot-charger": {
+                    "summary": "A summer day longer than the battery: a noon charge at the depot",
+                    "value": CHARGING_PLAN_EXAMPLE,
+                },
             }
         ),
     ],

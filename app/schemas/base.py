@@ -28,6 +28,7 @@ from core.params import (
     VanParams,
     VehicleParams,
     few_unknown,
+    field_path,
     get_preset,
     inside_validation,
 )
@@ -177,7 +178,7 @@ class VanRequest(ApiModel):
                     built[section] = model(**(base.model_dump() | wanted))
             except ValidationError as error:
                 for item in error.errors():
-                    path = ".".join(str(p) for p in item["loc"])
+                    path = field_path(item["loc"])
                     details.append((f"{section}.{path}" if path else section, item["msg"]))
         if details:
             message = "; ".join(f"{field}: {rule}" for field, rule in details)

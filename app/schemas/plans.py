@@ -92,6 +92,26 @@ class StopOut(ApiModel):
     )
 
 
+class ChargeOut(ApiModel):
+    """One charge of the round, where it happens in the timeline."""
+
+    charger_id: str = Field(..., description='Where: "depot" for the depot\'s charger.')
+    arrive: dt.datetime = Field(..., description="Arrival at the charger, local time.")
+    depart: dt.datetime = Field(
+        ..., description="Departure, plugging in and out included, local time."
+    )
+    soc_before: float = Field(..., description="State of charge when the charge starts [–].")
+    soc_after: float = Field(..., description="State of charge when it ends [–].")
+    grid_kwh: float = Field(
+        ...,
+        description="Energy from the grid: the charge (battery_kwh / charging_efficiency) and "
+        "the cab and refrigeration, which run from the grid while plugged in [kWh].",
+    )
+    battery_kwh: float = Field(..., description="Energy stored in the battery [kWh].")
+    minutes: float = Field(..., description="Minutes charging (plugging in and out aside).")
+    cost: float = Field(..., description="grid_kwh at the charger's price_per_kwh.")
+
+
 class Totals(ApiModel):
     """The whole round."""
 
@@ -129,6 +149,11 @@ class PlanResponse(ApiModel):
     tour: list[str] = Field(..., description="Ids in driving order, depot first and last.")
     legs: list[LegOut] = Field(..., description="The driven legs, in order.")
     stops: list[StopOut] = Field(..., description="The stops, in visiting order.")
+    charges: list[ChargeOut] = Field(
+        default_factory=list,
+        description="The charges between stops (the tour shows each return to the depot), in "
+        "order; the legs' and stops' states of charge and the battery verdict include them.",
+    )
     totals: Totals = Field(..., description="The whole round.")
     battery: BatteryOut = Field(..., description="Whether the battery holds out with its reserve.")
     weather: WeatherOut = Field(..., description="The weather the round was simulated with.")

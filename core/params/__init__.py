@@ -22,6 +22,7 @@ from core.params.base import (
     clock_time,
     describe_validation_error,
     few_unknown,
+    field_path,
     inside_validation,
 )
 from core.params.conditions import (
@@ -47,8 +48,10 @@ from core.params.places import (
     MAX_MATRIX_DURATION_S,
     MAX_STOPS,
     MAX_TIME_WINDOWS,
+    ChargePoint,
     Depot,
     Objective,
+    Place,
     RoadMatrix,
     Stop,
     TimeWindow,
@@ -85,6 +88,7 @@ __all__ = [
     "STREET_TYPES",
     "BatteryParams",
     "CargoBoxParams",
+    "ChargePoint",
     "ChargingSpell",
     "ClockTime",
     "Depot",
@@ -95,6 +99,7 @@ __all__ = [
     "Location",
     "Objective",
     "Params",
+    "Place",
     "Preset",
     "RoadMatrix",
     "Stop",
@@ -109,6 +114,7 @@ __all__ = [
     "clock_time",
     "describe_validation_error",
     "few_unknown",
+    "field_path",
     "get_preset",
     "inside_validation",
 ]

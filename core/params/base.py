@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import datetime as dt
 import re
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Annotated, Any
@@ -102,11 +102,21 @@ GRAVITY_MPS2 = 9.80665
 NEDC_DURATION_S = 1180.0
 
 
+def field_path(loc: Sequence[int | str]) -> str:
+    """A field's path as requests name it: ``stops[3].time_windows[1].start``."""
+    path = ""
+    for part in loc:
+        if part == "":
+            continue
+        path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
+    return path
+
+
 def describe_validation_error(error: ValidationError, prefix: str = "") -> str:
     """One line per pydantic error: ``field.path: rule``."""
     parts = []
     for item in error.errors():
-        path = ".".join(str(p) for p in (prefix, *item["loc"]) if p != "")
+        path = field_path((prefix, *item["loc"]))
         parts.append(f"{path or 'input'}: {item['msg']}")
     return "; ".join(parts)
 
@@ -169,5 +179,5 @@ class Params(BaseModel):
             first = error.errors()[0]["loc"]
             raise InvalidParameterError(
                 describe_validation_error(error, type(self).__name__),
-                field=".".join(str(p) for p in first) or None,
+                field=field_path(first) or None,
             ) from None

@@ -56,7 +56,7 @@ class ChargingSpell(Interval):
     """A spell plugged in at a charger during a simulated trace (the van stands)."""
 
     power_kw: float = Field(
-        ..., gt=0, le=1000, description="The charger's power [kW]; the van's curve caps it."
+        ..., ge=0.1, le=1000, description="The charger's power [kW]; the van's curve caps it."
     )
 
 

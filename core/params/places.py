@@ -15,14 +15,50 @@ from core.params.conditions import StreetTypeName
 T = TypeVar("T")
 
 
-class Depot(Params):
-    """Where the round starts and ends."""
+class Place(Params):
+    """A point of a round: the depot or a stop."""
 
     id: str = Field("depot", min_length=1, max_length=64, description="Identifier of the depot.")
     lat: float = Field(..., ge=-90, le=90, description="Latitude [°], north positive.")
     lon: float = Field(..., ge=-180, le=180, description="Longitude [°], east positive.")
     elevation_m: float | None = Field(
         None, ge=-500, le=9000, description="Elevation above sea level [m]; gives leg grades."
+    )
+
+
+#: Most minutes to plug in, start and unplug a charge.
+MAX_PLUG_MINUTES = 120.0
+
+
+class ChargePoint(Params):
+    """Charging points of one power at one place."""
+
+    power_kw: float = Field(
+        ...,
+        ge=1,
+        le=1000,
+        description="Power of each point [kW], at least 1 kW; the van's charging curve and "
+        "max_charge_power_kw cap it.",
+    )
+    points: int = Field(1, ge=1, le=100, description="How many vans charge at once, at least 1.")
+    price_per_kwh: float = Field(
+        0.0, ge=0, le=100, description="Price of the energy drawn from the grid [per kWh]."
+    )
+    plug_minutes: float = Field(
+        2.0,
+        ge=0,
+        le=MAX_PLUG_MINUTES,
+        description="Minutes to plug in, start and unplug, besides the charge itself.",
+    )
+
+
+class Depot(Place):
+    """Where the round starts and ends, and its chargers."""
+
+    charger: ChargePoint | None = Field(
+        None,
+        description="The depot's charge points: a van whose battery would not last comes back "
+        "between stops to charge what the rest of its round needs. Absent: no charging.",
     )
 
 
@@ -47,7 +83,7 @@ MAX_TIME_WINDOWS = 8
 MAX_STOPS = 5000
 
 
-class Stop(Depot):
+class Stop(Place):
     """A delivery stop."""
 
     id: str = Field(..., min_length=1, max_length=64, description="Unique identifier of the stop.")

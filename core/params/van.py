@@ -312,7 +312,10 @@ class ChargingPoint(Params):
 
     soc: float = Field(..., ge=0, le=1, description="State of charge [–], 0–1.")
     power_kw: float = Field(
-        ..., gt=0, le=1000, description="Charging power drawn from the charger here [kW]."
+        ...,
+        ge=0.1,
+        le=1000,
+        description="Charging power drawn from the charger here [kW], at least 0.1 kW.",
     )
 
 
@@ -356,10 +359,10 @@ class BatteryParams(Params):
     )
     max_charge_power_kw: float = Field(
         50.0,
-        gt=0,
+        ge=1,
         le=1000,
-        description="Most power the van takes from a charger [kW] (its on-board AC charger or "
-        "its DC inlet); caps every charger and the charging curve.",
+        description="Most power the van takes from a charger [kW], at least 1 kW (its on-board "
+        "AC charger or its DC inlet); caps every charger and the charging curve.",
     )
     charging_curve: list[ChargingPoint] | None = Field(
         None,

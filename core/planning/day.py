@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from core.arrays import FloatArray
 from core.clock import at
 from core.exceptions import NoRouteError
-from core.params import Depot
+from core.params import Place
 from core.planning.estimates import VanEstimates, van_estimates
 from core.planning.model import MAX_ROUND_S, PlanProblem, PlanResult, Solved, place_field
 from core.planning.scene import Scene
@@ -40,7 +40,7 @@ class VanShift:
     battery_enforced: bool = True
 
 
-def leg_roads(router: RoadRouter, places: list[Depot], order: list[int]) -> list[LegRoute]:
+def leg_roads(router: RoadRouter, places: list[Place], order: list[int]) -> list[LegRoute]:
     """The router's road of every leg of ``order``; a leg with no road names its destination."""
     roads = []
     for i, j in itertools.pairwise(order):

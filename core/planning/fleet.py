@@ -32,6 +32,7 @@ from core.exceptions import CoreError, InvalidParameterError
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import WeatherService, forecast_for
 from core.planning.day import FleetDay, VanShift, fleet_day, leg_roads
+from core.planning.depot_charging import charging_not_planned
 from core.planning.estimates import LearnedTimes
 from core.planning.explain import explain
 from core.planning.feasibility import Feasibility
@@ -128,7 +129,7 @@ def plan_fleet(
         verification_rounds=routed.verification_rounds,
         timezone=timezone_name,
         distance_source=legs.source,
-        warnings=list(day_weather[1]),
+        warnings=[*day_weather[1], *charging_not_planned(problem.depot)],
     )
 
 

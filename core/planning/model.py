@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import datetime as dt
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from pydantic import Field, ValidationInfo, field_validator
@@ -22,6 +22,7 @@ from core.params import (
     IsoDate,
     Objective,
     Params,
+    Place,
     RoadMatrix,
     Stop,
     StreetTypeName,
@@ -91,7 +92,7 @@ class RoundFields(Params):
     )
 
     @property
-    def places(self) -> list[Depot]:
+    def places(self) -> list[Place]:
         """The depot, then the stops in request order (index 0 is the depot)."""
         return [self.depot, *self.stops]
 
@@ -239,6 +240,24 @@ class StopResult:
 
 
 @dataclass(frozen=True)
+class ChargeResult:
+    """One charge of the round: where (``charger_id``, "depot" for the depot's), when, the
+    state of charge before and after [–], the energy drawn from the grid for the battery and
+    the consumers meanwhile and the energy stored in the battery [kWh], the minutes plugged
+    in, and what the grid energy costs at the charger's price."""
+
+    charger_id: str
+    arrive: dt.datetime
+    depart: dt.datetime
+    soc_before: float
+    soc_after: float
+    grid_kwh: float
+    battery_kwh: float
+    minutes: float
+    cost: float
+
+
+@dataclass(frozen=True)
 class DayProfile:
     """Cumulative energy per consumer over the clock time of the round (paper Fig. 8).
 
@@ -292,6 +311,7 @@ class PlanResult:
     objective: Objective
     profile: DayProfile
     late_stops: list[str]
+    charges: list[ChargeResult] = field(default_factory=list)
 
 
 UnassignedReason = Literal[

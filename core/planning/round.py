@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import datetime as dt
 import time
+from dataclasses import replace
 
 from core.clock import check_representable, departure
 from core.exceptions import InvalidStopsError, LimitExceededError, NoRouteError
 from core.physics.weather import WeatherService
 from core.planning.day import VanShift, fleet_day, leg_roads
+from core.planning.depot_charging import charging_not_planned, with_depot_charges
 from core.planning.estimates import cost_matrix
 from core.planning.fleet import search
 from core.planning.model import (
@@ -28,9 +30,8 @@ from core.planning.model import (
 )
 from core.planning.scene import Scene, legs_for, weather_service_for
 from core.planning.timeline import client_legs_too_fast, windows_after
-from core.planning.verify import simulate_route
 from core.routing.geo import Legs, build_legs
-from core.routing.roads import RememberingRouter, RoadRouter
+from core.routing.roads import LegRoute, RememberingRouter, RoadRouter
 from core.routing.tsp import solve_tour
 from core.routing.units import payload_units_down, payload_units_up
 
@@ -83,8 +84,15 @@ def plan(
             f"{MAX_ROUND_S / 3600:.0f} h",
             "stops",
         )
-    roads = leg_roads(router, scene.places, order) if router and legs.source == "osrm" else None
-    result = simulate_route(
+
+    remembering = None if router is None else RememberingRouter(router)
+
+    def roads(driven: list[int]) -> list[LegRoute] | None:
+        if remembering is None or legs.source != "osrm":
+            return None
+        return leg_roads(remembering, scene.places, driven)
+
+    result = with_depot_charges(
         problem,
         scene,
         order,
@@ -131,7 +139,8 @@ def _in_windows(
             f"no order of the round serves '{first.id}' in time: {first.detail}",
             field or f"stops[{index}]",
         )
-    return routed.stamped(time.perf_counter() - started)[0].plan
+    result = routed.stamped(time.perf_counter() - started)[0].plan
+    return replace(result, warnings=[*result.warnings, *charging_not_planned(problem.depot)])
 
 
 def _check_reachable(problem: PlanProblem, legs: Legs) -> None:

@@ -7,7 +7,7 @@ import datetime as dt
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from core.params import Depot
+from core.params import Place
 from core.physics.weather import Forecast, WeatherService, forecast_for
 from core.planning.model import RoundFields
 from core.routing.geo import Legs, build_legs
@@ -22,7 +22,7 @@ class Scene:
     """The places (the depot, then the stops), every ordered pair's leg, the zone's name for
     the answers, the weather of a day, and what every answer of it should warn of."""
 
-    places: list[Depot]
+    places: list[Place]
     legs: Legs
     timezone_name: str
     weather_for: WeatherFor

@@ -12,14 +12,22 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
 from core.arrays import FloatArray
-from core.params import STREET_TYPES, Depot, DoorOpening, Interval, Stop, StreetTypeName
+from core.params import (
+    STREET_TYPES,
+    ChargingSpell,
+    DoorOpening,
+    Interval,
+    Place,
+    Stop,
+    StreetTypeName,
+)
 from core.physics.cycles import (
     drive_profile,
     fastest_s,
@@ -63,6 +71,16 @@ def windows_after(
     return [[]] + [
         [(seconds(w.start), seconds(w.end)) for w in stop.time_windows] for stop in stops
     ]
+
+
+@dataclass(frozen=True)
+class DepotCharge:
+    """A return to the depot between stops to charge: the minutes to plug in and out and
+    the charge itself [s], at a charger of ``power_kw``."""
+
+    plug_s: float
+    charge_s: float
+    power_kw: float
 
 
 @dataclass(frozen=True)
@@ -200,6 +218,7 @@ class Timeline:
     street_types: list[StreetTypeName]
     geometry: list[list[tuple[float, float]]]
     capped_s: float = 0.0
+    charging: list[ChargingSpell] = field(default_factory=list)
 
     @property
     def duration_s(self) -> float:
@@ -226,6 +245,7 @@ class _Builder:
     street_types: list[StreetTypeName] = field(default_factory=list)
     geometry: list[list[tuple[float, float]]] = field(default_factory=list)
     capped_s: float = 0.0
+    charging: list[ChargingSpell] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.payload.append(np.array([self.payload_kg]))
@@ -269,6 +289,24 @@ class _Builder:
         self.payload_kg = max(self.payload_kg - stop.delivery_kg, 0.0)
         self.stand(dwell, self.payload_kg)
 
+    def charge(self, visit: DepotCharge) -> None:
+        """Stand at the depot: plug in, charge for ``visit.charge_s``, unplug."""
+        plug = math.ceil(visit.plug_s / 2 / PLAN_DT_S)
+        charge = math.ceil(visit.charge_s / PLAN_DT_S)
+        arrival_s = self.clock * PLAN_DT_S
+        self.parked.append(Interval(start_s=arrival_s, duration_s=(2 * plug + charge) * PLAN_DT_S))
+        self.stand(plug, self.payload_kg)
+        self.marks["serve"].append(self.clock)
+        if charge:
+            self.charging.append(
+                ChargingSpell(
+                    start_s=self.clock * PLAN_DT_S,
+                    duration_s=charge * PLAN_DT_S,
+                    power_kw=visit.power_kw,
+                )
+            )
+        self.stand(charge + plug, self.payload_kg)
+
     def finish(self) -> Timeline:
         marks = {name: np.array(values) for name, values in self.marks.items()}
         return Timeline(
@@ -286,19 +324,22 @@ class _Builder:
             street_types=self.street_types,
             geometry=self.geometry,
             capped_s=self.capped_s,
+            charging=self.charging,
         )
 
 
 def build_timeline(
     problem: PlanProblem,
-    places: list[Depot],
+    places: list[Place],
     legs: Legs,
     order: list[int],
     routes: list[LegRoute] | None,
     windows_s: Sequence[Windows] | None = None,
+    charges: Mapping[int, DepotCharge] | None = None,
 ) -> Timeline:
     """Speed, grade, payload and heading of every sample of the day, the door openings, the
-    stops and the marks, for the places in ``order`` (depot first and last). With
+    stops and the marks, for the places in ``order`` (depot first and last; the depot
+    between, the van comes back to charge as ``charges`` says, by position in ``order``). With
     ``windows_s`` (each place's time windows, seconds after the departure) the van waits,
     parked with the door shut, for a stop's window to open; a stop reached after its last
     window closes is served at once and listed in ``late``."""
@@ -319,6 +360,8 @@ def build_timeline(
         day.drive(leg.speed_mps, leg.heading_deg, float(legs.grade[i, j]))
         if j != 0:
             day.serve(j, problem.stops[j - 1], windows_s[j] if windows_s is not None else ())
+        elif charges is not None and k + 1 in charges:
+            day.charge(charges[k + 1])
         else:
             day.marks["serve"].append(day.clock)
         day.marks["leave"].append(day.clock)

@@ -8,17 +8,18 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from core.clock import at, check_representable
-from core.params import Depot, Location
+from core.params import Location, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.cycles import trace_distance_m
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate
 from core.planning.model import (
+    ChargeResult,
     DayProfile,
     LegResult,
     PlanProblem,
@@ -30,6 +31,7 @@ from core.planning.model import (
 from core.planning.scene import Scene
 from core.planning.timeline import (
     PLAN_DT_S,
+    DepotCharge,
     Timeline,
     Windows,
     build_timeline,
@@ -50,6 +52,7 @@ def simulate_route(
     solved: Solved,
     windows_s: Sequence[Windows] | None = None,
     latest_return_s: float | None = None,
+    charges: Mapping[int, DepotCharge] | None = None,
 ) -> PlanResult:
     """Drive the places in ``order`` (depot first and last) from ``start`` and simulate the day.
 
@@ -74,14 +77,18 @@ def simulate_route(
         and listed in ``late_stops``.
     latest_return_s
         When the van must be back [s after ``start``], if ever.
+    charges
+        The charges at the depot between stops, by their position in ``order``.
     """
-    timeline = build_timeline(problem, scene.places, scene.legs, order, roads, windows_s)
+    timeline = build_timeline(problem, scene.places, scene.legs, order, roads, windows_s, charges)
     if windows_s is not None:
         delay_s = later_departure_s(timeline, order, windows_s, latest_return_s)
         if delay_s > 0:
             start = at(start, delay_s)
             windows_s = [[(a - delay_s, b - delay_s) for a, b in place] for place in windows_s]
-            timeline = build_timeline(problem, scene.places, scene.legs, order, roads, windows_s)
+            timeline = build_timeline(
+                problem, scene.places, scene.legs, order, roads, windows_s, charges
+            )
     check_representable(start, timeline.duration_s, "date")
     weather, warnings = scene.weather_for(start, timeline.duration_s)
     if timeline.capped_s > 0:
@@ -103,6 +110,7 @@ def simulate_route(
         door_openings=timeline.doors,
         parked=timeline.parked,
         heading_deg=timeline.heading,
+        charging=timeline.charging,
     )
     return _Split(problem, scene, order, result, timeline, start).result(solved, warnings)
 
@@ -166,6 +174,8 @@ class _Split:
         out = []
         payload = self.problem.van.payload_kg
         for k, j in enumerate(self.order[1:-1]):
+            if j == 0:  # back at the depot to charge
+                continue
             b, c = int(self.timeline.arrive[k]), int(self.timeline.leave[k])
             served = int(self.timeline.serve[k])
             payload = max(payload - self.problem.stops[j - 1].delivery_kg, 0.0)
@@ -184,6 +194,31 @@ class _Split:
                     snap_distance_m=None if snap is None else float(snap[j]),
                     lat=places[j].lat,
                     lon=places[j].lon,
+                )
+            )
+        return out
+
+    def charges(self) -> list[ChargeResult]:
+        """The charges at the depot between stops, with what the simulation made of them."""
+        charger = self.problem.depot.charger
+        visits = [k for k, j in enumerate(self.order[1:-1]) if j == 0]
+        out = []
+        for k, spell, done in zip(
+            visits, self.timeline.charging, self.simulated.charges, strict=True
+        ):
+            b, c = int(self.timeline.arrive[k]), int(self.timeline.leave[k])
+            grid_kwh = (done.charge_grid_j + done.consumers_grid_j) / JOULES_PER_KWH
+            out.append(
+                ChargeResult(
+                    charger_id="depot",
+                    arrive=self.moment(b),
+                    depart=self.moment(c),
+                    soc_before=done.soc_before,
+                    soc_after=done.soc_after,
+                    grid_kwh=grid_kwh,
+                    battery_kwh=done.stored_j / JOULES_PER_KWH,
+                    minutes=spell.duration_s / 60,
+                    cost=grid_kwh * (charger.price_per_kwh if charger is not None else 0.0),
                 )
             )
         return out
@@ -234,6 +269,7 @@ class _Split:
             objective=self.problem.objective,
             profile=self.profile(),
             late_stops=[places[j].id for j in self.timeline.late],
+            charges=self.charges(),
         )
 
 
@@ -250,7 +286,7 @@ class Failure:
 def route_failure(
     van_id: str,
     problem: PlanProblem,
-    places: list[Depot],
+    places: list[Place],
     result: PlanResult,
     shift_end: dt.datetime | None,
     battery_enforced: bool,

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from core.arrays import FloatArray
 from core.exceptions import InvalidMatrixError
-from core.params import STREET_TYPES, Depot, RoadMatrix, StreetTypeName
+from core.params import STREET_TYPES, Place, RoadMatrix, StreetTypeName
 from core.routing.roads import RoadTable
 
 DistanceSource = Literal["osrm", "client", "estimate"]
@@ -113,7 +113,7 @@ def street_type_by_speed(distance_m: ArrayLike, duration_s: ArrayLike) -> NDArra
 
 
 def build_legs(
-    places: Sequence[Depot], matrix: RoadMatrix | None = None, table: RoadTable | None = None
+    places: Sequence[Place], matrix: RoadMatrix | None = None, table: RoadTable | None = None
 ) -> Legs:
     """Distances, durations, street types and grades of every ordered pair of places.
 

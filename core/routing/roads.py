@@ -15,7 +15,7 @@ from typing import Protocol
 import numpy as np
 
 from core.arrays import FloatArray
-from core.params import Depot
+from core.params import Place
 
 
 @dataclass(frozen=True)
@@ -64,14 +64,14 @@ class RoadRouter(Protocol):
 
     name: str
 
-    def table(self, places: Sequence[Depot]) -> RoadTable:
+    def table(self, places: Sequence[Place]) -> RoadTable:
         """Distances and durations of every ordered pair, NaN where no road leads; raises
         :class:`core.exceptions.ServiceUnavailableError` when the router fails and
         :class:`core.exceptions.InvalidStopsError` naming a stop it cannot use (too far from
         any road)."""
         ...
 
-    def route(self, origin: Depot, destination: Depot) -> LegRoute:
+    def route(self, origin: Place, destination: Place) -> LegRoute:
         """The road from ``origin`` to ``destination``."""
         ...
 
@@ -86,13 +86,13 @@ class RememberingRouter:
         self._tables: dict[tuple[tuple[float, float], ...], RoadTable] = {}
         self._routes: dict[tuple[float, float, float, float], LegRoute] = {}
 
-    def table(self, places: Sequence[Depot]) -> RoadTable:
+    def table(self, places: Sequence[Place]) -> RoadTable:
         key = tuple((p.lat, p.lon) for p in places)
         if key not in self._tables:
             self._tables[key] = self.inner.table(places)
         return self._tables[key]
 
-    def route(self, origin: Depot, destination: Depot) -> LegRoute:
+    def route(self, origin: Place, destination: Place) -> LegRoute:
         key = (origin.lat, origin.lon, destination.lat, destination.lon)
         if key not in self._routes:
             self._routes[key] = self.inner.route(origin, destination)

@@ -84,10 +84,10 @@ def test_a_colder_day_has_less_to_fill():
 @pytest.mark.parametrize(
     ("curve", "where"),
     [
-        ([{"soc": 0.0, "power_kw": 20}, {"soc": 0.8, "power_kw": 30}], ".1.power_kw"),
-        ([{"soc": 0.5, "power_kw": 20}, {"soc": 0.5, "power_kw": 10}], ".1.soc"),
-        ([{"soc": 0.0, "power_kw": 20}, {"soc": 1.2, "power_kw": 10}], ".1.soc"),
-        ([{"soc": 0.0, "power_kw": 0}, {"soc": 1.0, "power_kw": 5}], ".0.power_kw"),
+        ([{"soc": 0.0, "power_kw": 20}, {"soc": 0.8, "power_kw": 30}], "[1].power_kw"),
+        ([{"soc": 0.5, "power_kw": 20}, {"soc": 0.5, "power_kw": 10}], "[1].soc"),
+        ([{"soc": 0.0, "power_kw": 20}, {"soc": 1.2, "power_kw": 10}], "[1].soc"),
+        ([{"soc": 0.0, "power_kw": 0}, {"soc": 1.0, "power_kw": 5}], "[0].power_kw"),
         ([{"soc": 0.0, "power_kw": 20}], ""),
     ],
 )

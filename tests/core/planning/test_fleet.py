@@ -288,7 +288,7 @@ def test_a_hot_day_costs_the_fleet_more_than_a_mild_one():
                 lon=16.4,
                 time_windows=[window("08:00", "10:00"), window("09:00", "11:00")],
             ),
-            "time_windows.1.start",
+            "time_windows[1].start",
         ),
         (lambda: van("a", "12:00", "08:00"), "shift_end"),
         (
