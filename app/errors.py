@@ -19,6 +19,7 @@ from core.exceptions import (
     ServiceUnavailableError,
     TooMuchToWaitForError,
 )
+from core.params import BRANCH_TAG
 
 PROBLEM_JSON = "application/problem+json"
 E = TypeVar("E", bound=Exception)
@@ -100,6 +101,8 @@ def _location(loc: tuple[Any, ...], kind: str = "") -> str:
         return "body"
     path = ""
     for part in loc[1:] if loc and loc[0] == "body" else loc:
+        if isinstance(part, str) and part.startswith(BRANCH_TAG):  # a union's branch
+            continue
         name = _echo(str(part), MAX_ECHO_PART)
         path += f"[{part}]" if isinstance(part, int) else (f".{name}" if path else name)
     return path or "body"

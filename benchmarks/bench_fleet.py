@@ -117,7 +117,11 @@ def solomon_problem(
         ),
         vehicles=[
             FleetVehicle(
-                id=f"v{k}", van=van, shift_start="00:00", shift_end=clock(instance.window_min[0][1])
+                id=f"v{k}",
+                van=van,
+                shift_start="00:00",
+                shift_end=clock(instance.window_min[0][1]),
+                breaks="none",  # Solomon's rules have none
             )
             for k in range(VANS)
         ],

@@ -9,6 +9,7 @@ from app.operations.answers import attribution, battery, box, energy, weather
 from app.operations.limits import check_round, time_limit_s
 from app.schemas.base import EnergyShare, LineString, Point
 from app.schemas.plans import (
+    BreakOut,
     ChargeOut,
     Feature,
     LegOut,
@@ -67,6 +68,7 @@ def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanRes
         legs=legs,
         stops=stops,
         charges=[ChargeOut(**vars(charge)) for charge in result.charges],
+        breaks=[BreakOut(**vars(rest)) for rest in result.breaks],
         totals=Totals(
             distance_m=result.distance_m,
             duration_s=result.duration_s,

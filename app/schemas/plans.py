@@ -112,6 +112,18 @@ class ChargeOut(ApiModel):
     cost: float = Field(..., description="grid_kwh at the charger's price_per_kwh.")
 
 
+class BreakOut(ApiModel):
+    """A driver's break, parked (cab and refrigeration drawing)."""
+
+    start: dt.datetime = Field(..., description="Start, local time.")
+    end: dt.datetime = Field(..., description="End, local time.")
+    kind: str = Field(
+        ...,
+        description='"eu-561": the driving limit of Regulation (EC) No 561/2006 (also a wait '
+        'or a charge of 45 min that counts as the break); "fixed": one of the listed breaks.',
+    )
+
+
 class Totals(ApiModel):
     """The whole round."""
 
@@ -153,6 +165,9 @@ class PlanResponse(ApiModel):
         default_factory=list,
         description="The charges between stops (the tour shows each return to the depot), in "
         "order; the legs' and stops' states of charge and the battery verdict include them.",
+    )
+    breaks: list[BreakOut] = Field(
+        default_factory=list, description="The driver's breaks, in order (between stops)."
     )
     totals: Totals = Field(..., description="The whole round.")
     battery: BatteryOut = Field(..., description="Whether the battery holds out with its reserve.")

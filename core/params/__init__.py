@@ -9,6 +9,7 @@ presets (:mod:`~core.params.presets`); everything is importable from here.
 """
 
 from core.params.base import (
+    BRANCH_TAG,
     GRAVITY_MPS2,
     HHMM_PATTERN,
     MAX_TRACE_SAMPLES,
@@ -67,6 +68,7 @@ from core.params.van import (
 
 __all__ = [
     "AGGRESSIVE_DRIVER",
+    "BRANCH_TAG",
     "CALM_DRIVER",
     "DEFAULT_PRESET",
     "GRAVITY_MPS2",

@@ -102,11 +102,16 @@ GRAVITY_MPS2 = 9.80665
 NEDC_DURATION_S = 1180.0
 
 
+#: How a tagged union's branch names begin (``Tag(BRANCH_TAG + name)``): pydantic puts the
+#: branch in an error's location, which is not a field of the request.
+BRANCH_TAG = "~"
+
+
 def field_path(loc: Sequence[int | str]) -> str:
     """A field's path as requests name it: ``stops[3].time_windows[1].start``."""
     path = ""
     for part in loc:
-        if part == "":
+        if part == "" or (isinstance(part, str) and part.startswith(BRANCH_TAG)):
             continue
         path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
     return path

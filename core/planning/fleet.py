@@ -167,6 +167,7 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
             **fields_of(problem, RoundFields),
             start_time=vehicle.shift_start,
             time_limit_s=problem.time_limit_s,
+            breaks=vehicle.breaks,
             van=vehicle.van,
         )
         shifts.append(VanShift(vehicle.id, round_problem, ends[0], ends[1]))

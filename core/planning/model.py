@@ -9,12 +9,13 @@ from __future__ import annotations
 import datetime as dt
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import Field, ValidationInfo, field_validator
+from pydantic import Discriminator, Field, Tag, ValidationInfo, field_validator
 
 from core.exceptions import InvalidStopsError
 from core.params import (
+    BRANCH_TAG,
     MAX_STOPS,
     NORMAL_DRIVER,
     ClockTime,
@@ -103,6 +104,51 @@ def fields_of(source: Params, fields: type[Params]) -> dict[str, Any]:
     return {name: getattr(source, name) for name in fields.model_fields}
 
 
+#: Longest fixed break [min]: half a day.
+MAX_BREAK_MINUTES = 720.0
+
+
+class FixedBreak(Params):
+    """A break the driver takes at a set time of the day (lunch): it begins between
+    ``earliest`` and ``latest``, as soon as the van is free (between two stops)."""
+
+    earliest: ClockTime = Field(..., description="Earliest start, local HH:MM.")
+    latest: ClockTime = Field(..., description="Latest start, local HH:MM, not before earliest.")
+    minutes: float = Field(
+        ..., ge=1, le=MAX_BREAK_MINUTES, description="How long it lasts [min], 1–720."
+    )
+
+    @field_validator("latest")
+    @classmethod
+    def _not_before_earliest(cls, value: dt.time, info: ValidationInfo) -> dt.time:
+        if "earliest" in info.data and value < info.data["earliest"]:
+            raise ValueError("latest must not be before earliest")
+        return value
+
+
+#: Drivers' breaks: EU Regulation (EC) No 561/2006 (art. 7), none, or fixed breaks.
+def _break_branch(value: object) -> str:
+    return BRANCH_TAG + ("list" if isinstance(value, list) else "rule")
+
+
+Breaks = Annotated[
+    Annotated[Literal["eu-561", "none"], Tag(BRANCH_TAG + "rule")]
+    | Annotated[list[FixedBreak], Tag(BRANCH_TAG + "list")],
+    Discriminator(_break_branch),
+]
+
+
+def breaks_field(default: str) -> Any:
+    """The ``breaks`` field of a round or a van with its default."""
+    return Field(
+        default,
+        description='"eu-561": a 45-minute break before driving more than 4 h 30 min since '
+        "the last one (Regulation (EC) No 561/2006, art. 7; a wait or a charge of 45 min "
+        'counts); "none"; or a list of fixed breaks ({"earliest", "latest", "minutes"}). '
+        "Parked during a break: the cab and the refrigeration keep drawing.",
+    )
+
+
 class PlanFields(RoundFields):
     """One round: when it leaves, and whether its order is the client's."""
 
@@ -113,6 +159,7 @@ class PlanFields(RoundFields):
     )
     keep_order: bool = Field(False, description="Drive the stops in the given order.")
     time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT_S)
+    breaks: Breaks = breaks_field("none")
 
 
 class PlanProblem(PlanFields):
@@ -138,11 +185,26 @@ class ShiftFields(Params):
     shift_end: ClockTime = clock_field(
         "18:00", "Latest return to the depot, local HH:MM, after shift_start (same day)."
     )
+    breaks: Breaks = breaks_field("eu-561")
 
     @field_validator("shift_end")
     @classmethod
     def _after_start(cls, value: dt.time, info: ValidationInfo) -> dt.time:
         return shift_in_order(info.data.get("shift_start"), value)
+
+    @field_validator("breaks")
+    @classmethod
+    def _within_shift(cls, value: Breaks, info: ValidationInfo) -> Breaks:
+        start, end = info.data.get("shift_start"), info.data.get("shift_end")
+        if isinstance(value, list) and start is not None and end is not None:
+            shift_min = (end.hour * 60 + end.minute) - (start.hour * 60 + start.minute)
+            for k, fixed in enumerate(value):
+                if fixed.minutes > shift_min:
+                    raise ValueError(
+                        f"breaks[{k}] lasts {fixed.minutes:g} min, longer than the "
+                        f"{shift_min} min shift"
+                    )
+        return value
 
 
 class FleetVehicle(ShiftFields):
@@ -258,6 +320,15 @@ class ChargeResult:
 
 
 @dataclass(frozen=True)
+class BreakResult:
+    """A driver's break: when, and why ("eu-561" or "fixed")."""
+
+    start: dt.datetime
+    end: dt.datetime
+    kind: str
+
+
+@dataclass(frozen=True)
 class DayProfile:
     """Cumulative energy per consumer over the clock time of the round (paper Fig. 8).
 
@@ -312,6 +383,7 @@ class PlanResult:
     profile: DayProfile
     late_stops: list[str]
     charges: list[ChargeResult] = field(default_factory=list)
+    breaks: list[BreakResult] = field(default_factory=list)
 
 
 UnassignedReason = Literal[

@@ -57,20 +57,66 @@ def next_window(arrival_s: float, windows_s: Windows) -> tuple[float, float] | N
     return next(((a, b) for a, b in windows_s if arrival_s <= b), None)
 
 
+def seconds_after(date: dt.date, clock: dt.time, reference: dt.datetime) -> float:
+    """The local ``clock`` time on ``date`` in ``reference``'s zone, in seconds after
+    ``reference`` (elapsed time: daylight saving counted)."""
+    moment = dt.datetime.combine(date, clock, tzinfo=reference.tzinfo)
+    return moment.timestamp() - reference.timestamp()
+
+
 def windows_after(
     stops: Sequence[Stop], date: dt.date, reference: dt.datetime
 ) -> list[list[tuple[float, float]]]:
-    """Each place's time windows (depot first, none) in seconds after ``reference``: the local
-    clock times on ``date`` in ``reference``'s zone, as elapsed time (daylight saving counted)."""
-    zone = reference.tzinfo
-    origin = reference.timestamp()
-
-    def seconds(clock: dt.time) -> float:
-        return dt.datetime.combine(date, clock, tzinfo=zone).timestamp() - origin
-
+    """Each place's time windows (depot first, none) in seconds after ``reference``
+    (:func:`seconds_after`)."""
     return [[]] + [
-        [(seconds(w.start), seconds(w.end)) for w in stop.time_windows] for stop in stops
+        [
+            (seconds_after(date, w.start, reference), seconds_after(date, w.end, reference))
+            for w in stop.time_windows
+        ]
+        for stop in stops
     ]
+
+
+def rest_after(problem: PlanProblem, reference: dt.datetime) -> Rest:
+    """The round's breaks, fixed ones in seconds after ``reference``."""
+    if not isinstance(problem.breaks, list):
+        return Rest(eu_561=problem.breaks == "eu-561")
+    return Rest(
+        fixed=tuple(
+            (
+                seconds_after(problem.date, b.earliest, reference),
+                seconds_after(problem.date, b.latest, reference),
+                b.minutes * 60.0,
+            )
+            for b in problem.breaks
+        )
+    )
+
+
+#: Regulation (EC) No 561/2006, art. 7: after at most 4 h 30 min of driving a driver takes a
+#: break of at least 45 minutes [s].
+MAX_DRIVING_S = 4.5 * 3600
+EU_BREAK_S = 45 * 60.0
+
+
+@dataclass(frozen=True)
+class Rest:
+    """The driver's breaks on the day: whether the EU rule holds, and the fixed breaks as
+    ``(earliest, latest, duration)`` [s after the departure]."""
+
+    eu_561: bool = False
+    fixed: tuple[tuple[float, float, float], ...] = ()
+
+
+@dataclass(frozen=True)
+class Break:
+    """A break the timeline holds: from ``start_s`` to ``end_s`` after the departure, and
+    why — "eu-561" (the driving limit; a wait or a charge long enough counts) or "fixed"."""
+
+    start_s: float
+    end_s: float
+    kind: str
 
 
 @dataclass(frozen=True)
@@ -219,6 +265,7 @@ class Timeline:
     geometry: list[list[tuple[float, float]]]
     capped_s: float = 0.0
     charging: list[ChargingSpell] = field(default_factory=list)
+    breaks: list[Break] = field(default_factory=list)
 
     @property
     def duration_s(self) -> float:
@@ -246,6 +293,10 @@ class _Builder:
     geometry: list[list[tuple[float, float]]] = field(default_factory=list)
     capped_s: float = 0.0
     charging: list[ChargingSpell] = field(default_factory=list)
+    rest: Rest = field(default_factory=Rest)
+    driving_s: float = 0.0
+    breaks: list[Break] = field(default_factory=list)
+    taken: set[int] = field(default_factory=set)
 
     def __post_init__(self) -> None:
         self.payload.append(np.array([self.payload_kg]))
@@ -255,6 +306,7 @@ class _Builder:
         samples = trace[1:]
         self.marks["depart"].append(self.clock)
         self.clock += samples.size
+        self.driving_s += samples.size * PLAN_DT_S
         self.marks["arrive"].append(self.clock)
         self.speed.append(samples)
         self.heading.append(heading[1:])
@@ -269,6 +321,43 @@ class _Builder:
         self.payload.append(np.full(samples, payload_kg))
         self.clock += samples
 
+    def rest_before(self, drive_s: float) -> None:
+        """The breaks due before a leg of ``drive_s``: a fixed break whose time has come (or
+        that would be missed during the leg; the van waits for its earliest start), and the EU
+        break when the leg would take the driving since the last one past 4 h 30 min."""
+        for k, (earliest, latest, duration) in enumerate(self.rest.fixed):
+            now = self.clock * PLAN_DT_S
+            if k not in self.taken and (now >= earliest or now + drive_s > latest):
+                self.taken.add(k)
+                self.stand_parked(math.ceil(max(earliest - now, 0.0) / PLAN_DT_S))
+                self.take_break(duration, "fixed")
+        if self.rest.eu_561 and self.driving_s > 0 and self.driving_s + drive_s > MAX_DRIVING_S:
+            self.take_break(EU_BREAK_S, "eu-561")
+
+    def take_break(self, duration_s: float, kind: str) -> None:
+        start = self.clock
+        self.stand_parked(math.ceil(duration_s / PLAN_DT_S))
+        self.counts_as_break(start, kind)
+
+    def counts_as_break(self, start: int, kind: str) -> None:
+        """The van stood parked since sample ``start``: a break, and the EU one when long
+        enough."""
+        if self.clock - start <= 0:
+            return
+        long_enough = (self.clock - start) * PLAN_DT_S >= EU_BREAK_S
+        if kind != "eu-561" or long_enough:
+            self.breaks.append(Break(start * PLAN_DT_S, self.clock * PLAN_DT_S, kind))
+        if long_enough:
+            self.driving_s = 0.0
+
+    def stand_parked(self, samples: int) -> None:
+        """Stand ``samples`` parked with the door shut (the cab's duty while parked)."""
+        if samples > 0:
+            self.parked.append(
+                Interval(start_s=self.clock * PLAN_DT_S, duration_s=samples * PLAN_DT_S)
+            )
+            self.stand(samples, self.payload_kg)
+
     def serve(self, place: int, stop: Stop, windows_s: Windows) -> None:
         """Wait for the stop's window, then serve it with the door open; the van leaves
         lighter by what it unloaded."""
@@ -280,6 +369,8 @@ class _Builder:
         dwell = math.ceil(stop.service_time_s / PLAN_DT_S)
         self.parked.append(Interval(start_s=arrival_s, duration_s=(wait + dwell) * PLAN_DT_S))
         self.stand(wait, self.payload_kg)
+        if self.rest.eu_561 and wait * PLAN_DT_S >= EU_BREAK_S:  # the wait is the break
+            self.counts_as_break(self.clock - wait, "eu-561")
         self.marks["serve"].append(self.clock)
         if stop.door_open_s > 0:
             self.doors.append(
@@ -306,6 +397,8 @@ class _Builder:
                 )
             )
         self.stand(charge + plug, self.payload_kg)
+        if self.rest.eu_561 and charge * PLAN_DT_S >= EU_BREAK_S:  # charged during the break
+            self.counts_as_break(self.clock - charge - plug, "eu-561")
 
     def finish(self) -> Timeline:
         marks = {name: np.array(values) for name, values in self.marks.items()}
@@ -325,6 +418,7 @@ class _Builder:
             geometry=self.geometry,
             capped_s=self.capped_s,
             charging=self.charging,
+            breaks=self.breaks,
         )
 
 
@@ -336,20 +430,23 @@ def build_timeline(
     routes: list[LegRoute] | None,
     windows_s: Sequence[Windows] | None = None,
     charges: Mapping[int, DepotCharge] | None = None,
+    rest: Rest | None = None,
 ) -> Timeline:
     """Speed, grade, payload and heading of every sample of the day, the door openings, the
     stops and the marks, for the places in ``order`` (depot first and last; the depot
     between, the van comes back to charge as ``charges`` says, by position in ``order``). With
     ``windows_s`` (each place's time windows, seconds after the departure) the van waits,
     parked with the door shut, for a stop's window to open; a stop reached after its last
-    window closes is served at once and listed in ``late``."""
-    day = _Builder(problem.van.payload_kg)
+    window closes is served at once and listed in ``late``. ``rest``: the driver's breaks,
+    taken between stops (:meth:`_Builder.rest_before`)."""
+    day = _Builder(problem.van.payload_kg, rest=rest or Rest())
     for k, (i, j) in enumerate(itertools.pairwise(order)):
         a, b = places[i], places[j]
         route = routes[k] if routes is not None else None
         leg = drive(
             problem, legs, i, j, route, bearing_deg(a.lat, a.lon, b.lat, b.lon), day.payload_kg
         )
+        day.rest_before((leg.speed_mps.size - 1) * PLAN_DT_S)
         day.street_types.append(leg.street_type)
         day.capped_s += leg.capped_s
         day.geometry.append(

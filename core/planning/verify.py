@@ -19,6 +19,7 @@ from core.physics.battery import JOULES_PER_KWH
 from core.physics.cycles import trace_distance_m
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate
 from core.planning.model import (
+    BreakResult,
     ChargeResult,
     DayProfile,
     LegResult,
@@ -36,6 +37,7 @@ from core.planning.timeline import (
     Windows,
     build_timeline,
     later_departure_s,
+    rest_after,
 )
 from core.routing.roads import LegRoute
 
@@ -80,15 +82,18 @@ def simulate_route(
     charges
         The charges at the depot between stops, by their position in ``order``.
     """
-    timeline = build_timeline(problem, scene.places, scene.legs, order, roads, windows_s, charges)
+
+    def laid_out(departure: dt.datetime, windows: Sequence[Windows] | None) -> Timeline:
+        places, legs, rest = scene.places, scene.legs, rest_after(problem, departure)
+        return build_timeline(problem, places, legs, order, roads, windows, charges, rest)
+
+    timeline = laid_out(start, windows_s)
     if windows_s is not None:
         delay_s = later_departure_s(timeline, order, windows_s, latest_return_s)
         if delay_s > 0:
             start = at(start, delay_s)
             windows_s = [[(a - delay_s, b - delay_s) for a, b in place] for place in windows_s]
-            timeline = build_timeline(
-                problem, scene.places, scene.legs, order, roads, windows_s, charges
-            )
+            timeline = laid_out(start, windows_s)
     check_representable(start, timeline.duration_s, "date")
     weather, warnings = scene.weather_for(start, timeline.duration_s)
     if timeline.capped_s > 0:
@@ -270,6 +275,10 @@ class _Split:
             profile=self.profile(),
             late_stops=[places[j].id for j in self.timeline.late],
             charges=self.charges(),
+            breaks=[
+                BreakResult(self.moment(round(b.start_s)), self.moment(round(b.end_s)), b.kind)
+                for b in self.timeline.breaks
+            ],
         )
 
 
