@@ -128,6 +128,13 @@ def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> Plan
                 },
             )
         )
+    for charge in result.charges:  # at the depot, the only charger a round visits yet
+        features.append(
+            Feature(
+                geometry=Point(coordinates=(depot_lon, depot_lat)),
+                properties={"kind": "charge"} | ChargeOut(**vars(charge)).model_dump(mode="json"),
+            )
+        )
     for index, leg in enumerate(result.legs):
         properties: dict[str, Any] = {
             "kind": "leg",

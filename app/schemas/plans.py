@@ -196,13 +196,15 @@ class Feature(ApiModel):
 
 class PlanFeatureCollection(ApiModel):
     """The plan as a GeoJSON FeatureCollection: the depot and stops as Points (id, arrival,
-    door heat, state of charge), the legs as LineStrings (energy per consumer, state of charge
-    at both ends)."""
+    door heat, state of charge), each charge as a Point where it happens (kind "charge", the
+    fields of `charges[]`), the legs as LineStrings (energy per consumer, state of charge at
+    both ends)."""
 
     type: Literal["FeatureCollection"] = Field(
         "FeatureCollection", description="Always FeatureCollection."
     )
     features: list[Feature] = Field(
-        ..., description="The depot and the stops (Points), then the legs (LineStrings)."
+        ...,
+        description="The depot, the stops and the charges (Points), then the legs (LineStrings).",
     )
     attribution: str | None = Field(None, description="Credit for the map data.")

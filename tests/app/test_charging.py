@@ -95,3 +95,17 @@ def test_bad_chargers_and_curves_are_422_naming_the_field(client, change, field)
     assert response.status_code == 422
     assert response.headers["content-type"] == PROBLEM
     assert any(e["field"] == field for e in response.json()["errors"]), response.json()["errors"]
+
+
+def test_the_map_shows_each_charge_at_the_depot(client):
+    response = client.post(
+        "/v1/plans", json=CHARGING_PLAN_EXAMPLE, headers={"Accept": "application/geo+json"}
+    )
+    assert response.status_code == 200
+    features = response.json()["features"]
+    charges = [f for f in features if f["properties"]["kind"] == "charge"]
+    depot = CHARGING_PLAN_EXAMPLE["depot"]
+    assert charges and all(
+        f["geometry"]["coordinates"] == [depot["lon"], depot["lat"]] for f in charges
+    )
+    assert charges[0]["properties"]["soc_after"] > charges[0]["properties"]["soc_before"]
