@@ -82,12 +82,13 @@ def with_depot_charges(
             if fitting == 0:
                 order, charges = _without_idle(order, _fitted(problem, order, result, charges))
     if not result.battery.feasible:
-        reason = (
-            "no stop of the trip lets the van reach the depot with its reserve"
-            if _first_short_trip(problem, order, result) is not None
-            else "the charges do not cover the round"
+        leg = result.first_infeasible_leg
+        where = f" on the way to '{result.legs[leg].to_id}'" if leg is not None else ""
+        warning = (
+            f"even with charges at the depot the battery runs below its reserve{where}: no "
+            "stop before it lets the van come back to charge with its reserve (no charger "
+            "within reach)"
         )
-        warning = f"even with charges at the depot the battery does not last: {reason}"
         result = replace(result, warnings=[*result.warnings, warning])
     return result
 

@@ -142,4 +142,7 @@ def test_a_stop_beyond_any_charge_says_so():
     far = Stop(id="far", lat=48.21, lon=16.37 + 2.2, service_time_s=600, door_open_s=60)
     result = plan(problem.model_copy(update={"stops": [*problem.stops[:5], far]}))
     assert not result.battery.feasible
-    assert any("even with charges at the depot" in w for w in result.warnings)
+    assert any(
+        "even with charges at the depot" in w and "no charger within reach" in w
+        for w in result.warnings
+    )
