@@ -14,7 +14,7 @@ from fastapi.testclient import TestClient
 from app.connectors.osrm import OsrmRouter
 from app.examples import SCENARIOS_EXAMPLE
 from core.exceptions import NoRouteError
-from core.params import Depot
+from core.params import Place
 from core.planning.day import leg_roads
 from tests.app.apps import app_client
 from tools import osrm
@@ -185,7 +185,7 @@ def islands_url(tmp_path_factory):
 
 
 def island_places():
-    return [Depot(id=n, lat=lat, lon=lon) for n, lat, lon in [*ISLAND_A, ISLAND_B]]
+    return [Place(id=n, lat=lat, lon=lon) for n, lat, lon in [*ISLAND_A, ISLAND_B]]
 
 
 def test_a_stop_no_road_reaches_is_named(islands_url):
@@ -260,7 +260,7 @@ def test_a_router_answering_garbage_is_a_503(weather_stub):
 
 
 def test_the_table_in_blocks_equals_one_call(osrm_url, monaco_osrm):
-    places = [Depot(id=n, lat=lat, lon=lon) for n, (lat, lon) in PLACES.items()]
+    places = [Place(id=n, lat=lat, lon=lon) for n, (lat, lon) in PLACES.items()]
     whole = OsrmRouter(osrm_url, 5, 100, 500).table(places)
     blocks = OsrmRouter(osrm_url, 5, 4, 500).table(places)  # 9 places: a last block of one
     assert blocks.distance_m == pytest.approx(whole.distance_m)
