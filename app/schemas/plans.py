@@ -158,7 +158,11 @@ class SolverOut(ApiModel):
 class PlanResponse(ApiModel):
     """The planned and simulated round."""
 
-    tour: list[str] = Field(..., description="Ids in driving order, depot first and last.")
+    tour: list[str] = Field(
+        ...,
+        description='Ids in driving order, depot first and last ("start", the van\'s position, '
+        "first with start_state); the depot between is a return to charge.",
+    )
     legs: list[LegOut] = Field(..., description="The driven legs, in order.")
     stops: list[StopOut] = Field(..., description="The stops, in visiting order.")
     charges: list[ChargeOut] = Field(

@@ -212,6 +212,7 @@ def simulate(
     parked: Sequence[Interval] = (),
     heading_deg: ArrayLike | None = None,
     charging: Sequence[ChargingSpell] = (),
+    box_start_c: float | None = None,
 ) -> SimulationResult:
     """Simulate every consumer of the van along one speed trace (paper Fig. 7, one leg).
 
@@ -247,6 +248,10 @@ def simulate(
         When the van is plugged in, seconds after start, and the charger's power: the battery
         charges along its curve (:mod:`core.physics.charging`) and every consumer runs from
         the grid meanwhile.
+    box_start_c
+        The box's temperature at the start [°C] of a van already under way (its day planned
+        again): its cab is at temperature and nothing is pre-conditioned. None: the start is
+        the depot's departure (``precondition_at_depot`` says how the van leaves).
 
     Returns
     -------
@@ -260,8 +265,9 @@ def simulate(
     check_representable(start, end_s)
     time_s = np.arange(n) * dt_s
     outside = _environment(start, location, van, weather, n - 1, dt_s)
-    power, box, cab_gap_j = _consumers(van, trace, dt_s, outside)
+    power, box, cab_gap_j = _consumers(van, trace, dt_s, outside, box_start_c)
     soc, verdict, loss_j, charges = _battery(van, power, dt_s, outside, trace.charging)
+    departs_depot = van.precondition_at_depot and box_start_c is None
     grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c)
     return SimulationResult(
         time_s=time_s,
@@ -269,7 +275,7 @@ def simulate(
         power_w=power,
         energy_kwh=_energy_kwh(power, dt_s),
         battery_loss_kwh=loss_j / battery_model.JOULES_PER_KWH,
-        grid_kwh=grid_j / battery_model.JOULES_PER_KWH if van.precondition_at_depot else 0.0,
+        grid_kwh=grid_j / battery_model.JOULES_PER_KWH if departs_depot else 0.0,
         distance_m=trace_distance_m(speed, dt_s),
         duration_s=end_s,
         soc=soc,
@@ -357,10 +363,15 @@ def _driven(
 
 
 def _consumers(
-    van: VanParams, trace: _Trace, dt_s: float, outside: _Environment
+    van: VanParams,
+    trace: _Trace,
+    dt_s: float,
+    outside: _Environment,
+    box_start_c: float | None = None,
 ) -> tuple[dict[str, FloatArray], BoxResult, float]:
     """Each consumer's power over each step [W] (:data:`CONSUMERS`), the box, and the energy a
-    cab at the outside temperature needs to reach 20 °C [J]."""
+    cab at the outside temperature needs to reach 20 °C [J] (none for a van under way,
+    ``box_start_c`` given)."""
     speed = trace.speed
     n_steps = speed.size - 1
     box = refrigeration(
@@ -370,9 +381,13 @@ def _consumers(
         door_open_fraction(trace.door_openings, np.arange(1, n_steps + 1) * dt_s, dt_s),
         np.broadcast_to(trace.payload_step, outside.ambient_c.shape),
         dt_s,
-        initial_c=None if van.precondition_at_depot else outside.start_c,
+        initial_c=(
+            box_start_c
+            if box_start_c is not None
+            else (None if van.precondition_at_depot else outside.start_c)
+        ),
     )
-    cab_gap_j = _cab_gap_j(van, outside.start_c)
+    cab_gap_j = 0.0 if box_start_c is not None else _cab_gap_j(van, outside.start_c)
     power = {
         "traction": step_traction_power_w(
             van.vehicle,

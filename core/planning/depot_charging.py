@@ -41,6 +41,8 @@ PARTIAL_CHARGE_MARGIN = 0.03
 RETURN_ENERGY_FACTOR = 1.25
 
 Roads = Callable[[list[int]], list[LegRoute] | None]
+#: A trip's places (the depot first and last) in a better order, the depot still first and last.
+Reorder = Callable[[list[int]], list[int]]
 
 
 def with_depot_charges(
@@ -51,9 +53,12 @@ def with_depot_charges(
     roads: Roads,
     solved: Solved,
     windows_s: Sequence[Windows] | None = None,
+    reorder: Reorder | None = None,
 ) -> PlanResult:
     """The round in ``order`` simulated, with returns to the depot's charger between stops
-    where the battery would not last (none when it does, or without a charger)."""
+    where the battery would not last (none when it does, or without a charger). With
+    ``reorder``, each trip is then put in its own best order, kept when the day holds and is
+    better on the round's objective."""
     result = simulate_route(problem, scene, order, start, roads(order), solved, windows_s)
     charger = problem.depot.charger
     if charger is None or result.battery.feasible:
@@ -81,6 +86,10 @@ def with_depot_charges(
             )
             if fitting == 0:
                 order, charges = _without_idle(order, _fitted(problem, order, result, charges))
+    if reorder is not None and charges and result.battery.feasible:
+        result = _with_trips_reordered(
+            problem, scene, order, start, roads, solved, windows_s, charges, reorder, result
+        )
     if not result.battery.feasible:
         leg = result.first_infeasible_leg
         where = f" on the way to '{result.legs[leg].to_id}'" if leg is not None else ""
@@ -91,6 +100,49 @@ def with_depot_charges(
         )
         result = replace(result, warnings=[*result.warnings, warning])
     return result
+
+
+def _with_trips_reordered(
+    problem: PlanProblem,
+    scene: Scene,
+    order: list[int],
+    start: dt.datetime,
+    roads: Roads,
+    solved: Solved,
+    windows_s: Sequence[Windows] | None,
+    charges: dict[int, DepotCharge],
+    reorder: Reorder,
+    result: PlanResult,
+) -> PlanResult:
+    """The day with each trip in its own best order (the returns stay where they are, every
+    trip keeps its stops), its charges fitted again; ``result`` when that is not better on
+    the objective."""
+    depots = _depot_positions(order)
+    trips = [
+        reorder(order[a : b + 1]) if order[a] == 0 else order[a : b + 1]  # not from under way
+        for a, b in itertools.pairwise(depots)
+    ]
+    shorter = [order[0], *(place for trip in trips for place in trip[1:])]
+    if shorter == order:
+        return result
+    first = simulate_route(
+        problem, scene, shorter, start, roads(shorter), solved, windows_s, charges=charges
+    )
+    shorter, fitted = _without_idle(shorter, _fitted(problem, shorter, first, charges))
+    again = simulate_route(
+        problem, scene, shorter, start, roads(shorter), solved, windows_s, charges=fitted
+    )
+    better = again.battery.feasible and _measure(again) < _measure(result)
+    return again if better else result
+
+
+def _measure(result: PlanResult) -> float:
+    """The round on its objective, as simulated: metres, seconds or kWh."""
+    if result.objective == "duration":
+        return result.duration_s
+    if result.objective == "energy":
+        return result.energy_kwh["total"]
+    return result.distance_m
 
 
 def charging_not_planned(depot: Depot) -> list[str]:
@@ -105,8 +157,9 @@ def charging_not_planned(depot: Depot) -> list[str]:
 
 
 def _depot_positions(order: list[int]) -> list[int]:
-    """Where the van is at the depot in ``order``: its start, each return, its end."""
-    return [q for q, place in enumerate(order) if place == 0]
+    """Where the trips of ``order`` begin and end: its start (the depot, or the van's position
+    when it starts under way), each return to the depot, its end."""
+    return [0, *(q for q in range(1, len(order)) if order[q] == 0)]
 
 
 def _trip_low(result: PlanResult, first: int, last: int) -> float:

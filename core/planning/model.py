@@ -21,6 +21,7 @@ from core.params import (
     ClockTime,
     Depot,
     IsoDate,
+    IsoDateTime,
     Objective,
     Params,
     Place,
@@ -149,6 +150,27 @@ def breaks_field(default: str) -> Any:
     )
 
 
+class StartState(Params):
+    """Where a van is when the rest of its day is planned again (at noon, say): it drives
+    from here through the stops left and back to the depot."""
+
+    lat: float = Field(..., ge=-90, le=90, description="Latitude [°], north positive.")
+    lon: float = Field(..., ge=-180, le=180, description="Longitude [°], east positive.")
+    time: IsoDateTime = Field(
+        ..., description="When it leaves from here, ISO 8601 with UTC offset, on the date."
+    )
+    soc: float = Field(..., ge=0, le=1, description="State of charge now [–], 0–1.")
+    box_temperature_c: float | None = Field(
+        None, ge=-40, le=60, description="The box's temperature now [°C]; absent: the set-point."
+    )
+    payload_kg: float | None = Field(
+        None, ge=0, le=40_000, description="Payload aboard now [kg]; absent: the van's payload_kg."
+    )
+    driving_since_break_s: float = Field(
+        0.0, ge=0, le=86_400, description="Driving since the driver's last break [s] (EU 561)."
+    )
+
+
 class PlanFields(RoundFields):
     """One round: when it leaves, and whether its order is the client's."""
 
@@ -160,6 +182,13 @@ class PlanFields(RoundFields):
     keep_order: bool = Field(False, description="Drive the stops in the given order.")
     time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT_S)
     breaks: Breaks = breaks_field("none")
+    start_state: StartState | None = Field(
+        None,
+        description="Plan the rest of a day from where the van is (its position, time, charge, "
+        "box temperature, payload, driving since the last break) to the depot; rounds "
+        "without time windows and without a client matrix. Absent: from the depot at "
+        "start_time.",
+    )
 
 
 class PlanProblem(PlanFields):

@@ -14,6 +14,8 @@ import datetime as dt
 import time
 from dataclasses import replace
 
+import numpy as np
+
 from core.clock import check_representable, departure
 from core.exceptions import InvalidStopsError, LimitExceededError, NoRouteError
 from core.physics.weather import WeatherService
@@ -29,11 +31,21 @@ from core.planning.model import (
     check_stop_ids,
 )
 from core.planning.scene import Scene, legs_for, weather_service_for
+from core.planning.start_state import (
+    check_start,
+    path_tour,
+    round_places,
+    under_way,
+)
 from core.planning.timeline import client_legs_too_fast, windows_after
 from core.routing.geo import Legs, build_legs
 from core.routing.roads import LegRoute, RememberingRouter, RoadRouter
 from core.routing.tsp import solve_tour
 from core.routing.units import payload_units_down, payload_units_up
+
+#: Search budget for each trip of a round that comes back to charge [s]: trips are short
+#: enough for CP-SAT's proof within it.
+TRIP_TIME_LIMIT_S = 0.2
 
 
 def plan(
@@ -59,11 +71,14 @@ def plan(
     """
     started = time.perf_counter()
     start, timezone_name = check(problem)
-    legs = legs_for(problem, router)
+    start = check_start(problem, start.tzinfo) or start
+    problem = under_way(problem)
+    places = round_places(problem)
+    legs = legs_for(problem, router, places)
     _check_reachable(problem, legs)
     too_fast = client_legs_too_fast(legs, problem.van.vehicle.max_acceleration_mps2)
     scene = Scene(
-        problem.places,
+        places,
         legs,
         timezone_name,
         weather_service_for(problem, weather_service),
@@ -73,7 +88,10 @@ def plan(
     if windowed and not problem.keep_order:
         return _in_windows(problem, scene, start, router, started)
     cost, unit_value, offset = cost_matrix(problem, legs, start)
-    tour = solve_tour(cost, problem.time_limit_s, problem.keep_order)
+    if problem.start_state is None:
+        tour = solve_tour(cost, problem.time_limit_s, problem.keep_order)
+    else:
+        tour = path_tour(cost, problem.time_limit_s, problem.keep_order)
     order = tour.order
     round_s = float(legs.duration_s[order[:-1], order[1:]].sum()) + sum(
         stop.service_time_s for stop in problem.stops
@@ -92,6 +110,11 @@ def plan(
             return None
         return leg_roads(remembering, scene.places, driven)
 
+    def reorder(trip: list[int]) -> list[int]:
+        places = trip[:-1]
+        best = solve_tour(cost[np.ix_(places, places)], TRIP_TIME_LIMIT_S)
+        return [places[k] for k in best.order]
+
     result = with_depot_charges(
         problem,
         scene,
@@ -100,6 +123,7 @@ def plan(
         roads,
         Solved(tour.status, tour.cost * unit_value + offset * (len(order) - 1), tour.runtime_s),
         windows_after(problem.stops, problem.date, start) if windowed else None,
+        None if problem.keep_order else reorder,
     )
     if result.late_stops:  # the client's own order misses a window
         late = result.late_stops[0]
@@ -144,8 +168,14 @@ def _in_windows(
 
 
 def _check_reachable(problem: PlanProblem, legs: Legs) -> None:
-    """Every stop can be driven to from the depot and back (a router may find no road)."""
+    """Every stop (and the van's position) can be driven to from the depot and back (a router
+    may find no road)."""
     for index in legs.unreachable():
+        if index > len(problem.stops):
+            raise NoRouteError(
+                f"no road links the van's position with the depot '{problem.depot.id}'",
+                "start_state",
+            )
         raise NoRouteError(
             f"no road links '{problem.stops[index - 1].id}' with the depot '{problem.depot.id}'",
             f"stops[{index - 1}]",

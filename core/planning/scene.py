@@ -29,10 +29,12 @@ class Scene:
     notes: tuple[str, ...] = ()
 
 
-def legs_for(problem: RoundFields, router: RoadRouter | None) -> Legs:
-    """Every ordered pair's leg: the client's matrix, else the router's table, else the
-    estimate."""
-    places = problem.places
+def legs_for(
+    problem: RoundFields, router: RoadRouter | None, places: list[Place] | None = None
+) -> Legs:
+    """Every ordered pair's leg between ``places`` (by default the depot and the stops): the
+    client's matrix, else the router's table, else the estimate."""
+    places = problem.places if places is None else places
     table = router.table(places) if router is not None and problem.matrix is None else None
     return build_legs(places, problem.matrix, table)
 

@@ -80,8 +80,10 @@ def windows_after(
 
 def rest_after(problem: PlanProblem, reference: dt.datetime) -> Rest:
     """The round's breaks, fixed ones in seconds after ``reference``."""
+    state = problem.start_state
+    driven_s = 0.0 if state is None else state.driving_since_break_s
     if not isinstance(problem.breaks, list):
-        return Rest(eu_561=problem.breaks == "eu-561")
+        return Rest(eu_561=problem.breaks == "eu-561", driven_s=driven_s)
     return Rest(
         fixed=tuple(
             (
@@ -90,7 +92,8 @@ def rest_after(problem: PlanProblem, reference: dt.datetime) -> Rest:
                 b.minutes * 60.0,
             )
             for b in problem.breaks
-        )
+        ),
+        driven_s=driven_s,
     )
 
 
@@ -102,11 +105,13 @@ EU_BREAK_S = 45 * 60.0
 
 @dataclass(frozen=True)
 class Rest:
-    """The driver's breaks on the day: whether the EU rule holds, and the fixed breaks as
-    ``(earliest, latest, duration)`` [s after the departure]."""
+    """The driver's breaks on the day: whether the EU rule holds, the fixed breaks as
+    ``(earliest, latest, duration)`` [s after the departure], and the driving since the last
+    break at the departure [s]."""
 
     eu_561: bool = False
     fixed: tuple[tuple[float, float, float], ...] = ()
+    driven_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -439,7 +444,8 @@ def build_timeline(
     parked with the door shut, for a stop's window to open; a stop reached after its last
     window closes is served at once and listed in ``late``. ``rest``: the driver's breaks,
     taken between stops (:meth:`_Builder.rest_before`)."""
-    day = _Builder(problem.van.payload_kg, rest=rest or Rest())
+    rest = rest or Rest()
+    day = _Builder(problem.van.payload_kg, rest=rest, driving_s=rest.driven_s)
     for k, (i, j) in enumerate(itertools.pairwise(order)):
         a, b = places[i], places[j]
         route = routes[k] if routes is not None else None

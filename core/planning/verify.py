@@ -30,6 +30,7 @@ from core.planning.model import (
     UnassignedReason,
 )
 from core.planning.scene import Scene
+from core.planning.start_state import box_start_c
 from core.planning.timeline import (
     PLAN_DT_S,
     DepotCharge,
@@ -116,6 +117,7 @@ def simulate_route(
         parked=timeline.parked,
         heading_deg=timeline.heading,
         charging=timeline.charging,
+        box_start_c=box_start_c(problem),
     )
     return _Split(problem, scene, order, result, timeline, start).result(solved, warnings)
 

@@ -146,3 +146,16 @@ def test_a_stop_beyond_any_charge_says_so():
         "even with charges at the depot" in w and "no charger within reach" in w
         for w in result.warnings
     )
+
+
+def test_each_trip_is_put_in_its_own_best_order(charged, flat):
+    # The same round in the order the round trip found, kept as it is: the returns are cut
+    # into it where they fall. Letting each trip find its own order is never longer.
+    problem = summer_day(ChargePoint(power_kw=22.0, price_per_kwh=0.3))
+    by_id = {stop.id: stop for stop in problem.stops}
+    as_found = problem.model_copy(
+        update={"stops": [by_id[i] for i in flat.tour[1:-1]], "keep_order": True}
+    )
+    kept = plan(as_found)
+    assert kept.battery.feasible and len(kept.charges) == len(charged.charges)
+    assert charged.distance_m <= kept.distance_m

@@ -1,0 +1,114 @@
+"""The rest of a day planned again from where the van is (``start_state``): it leaves from its
+position, at its time, with its charge, box temperature and payload, serves the stops left and
+returns to the depot.
+
+The van's position is one more place after the stops (:func:`round_places`); the order is the
+shortest path from it through every stop to the depot, solved as a round trip on a matrix
+where the only way out of the depot leads back to the start at no cost (:func:`path_tour`).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from core.exceptions import InvalidParameterError
+from core.params import MIN_SOC_WINDOW, Place
+from core.planning.model import PlanProblem
+from core.routing.tsp import Tour, solve_tour
+
+#: The id of the van's position in the tour and the legs.
+START_ID = "start"
+
+
+def round_places(problem: PlanProblem) -> list[Place]:
+    """The depot, the stops, and the van's position when the day starts under way."""
+    state = problem.start_state
+    if state is None:
+        return problem.places
+    return [*problem.places, Place(id=START_ID, lat=state.lat, lon=state.lon)]
+
+
+def check_start(problem: PlanProblem, zone: dt.tzinfo | None) -> dt.datetime | None:
+    """The departure from the van's position in the round's zone, or None without a start
+    state; raises :class:`core.exceptions.InvalidParameterError` naming the field for what
+    cannot be planned from it."""
+    state = problem.start_state
+    if state is None:
+        return None
+    if problem.matrix is not None:
+        raise InvalidParameterError(
+            "a client matrix has no row for the van's position: leave out matrix (the "
+            "planner estimates the legs or asks its router) or start_state",
+            "start_state",
+        )
+    if any(stop.time_windows for stop in problem.stops):
+        raise InvalidParameterError(
+            "a start state is planned for rounds without time windows", "start_state"
+        )
+    battery = problem.van.battery
+    if state.soc < battery.min_soc + MIN_SOC_WINDOW:
+        raise InvalidParameterError(
+            f"soc {state.soc:g} is less than {MIN_SOC_WINDOW:g} above the reserve min_soc "
+            f"{battery.min_soc:g}: the van cannot plan a round on it",
+            "start_state.soc",
+        )
+    delivered = sum(stop.delivery_kg for stop in problem.stops)
+    if state.payload_kg is not None and state.payload_kg < delivered - 1e-9:
+        raise InvalidParameterError(
+            f"payload_kg {state.payload_kg:g} is less than the {delivered:g} kg the stops left "
+            "take",
+            "start_state.payload_kg",
+        )
+    moment = state.time.astimezone(zone)
+    if moment.date() != problem.date:
+        raise InvalidParameterError(
+            f"{state.time.isoformat()} is on {moment.date()} in the round's zone, not on the "
+            f"round's date {problem.date}",
+            "start_state.time",
+        )
+    return moment
+
+
+def under_way(problem: PlanProblem) -> PlanProblem:
+    """The round with the van as it is now: its charge and payload (the start state's)."""
+    state = problem.start_state
+    if state is None:
+        return problem
+    van = problem.van
+    battery = van.battery.model_copy(update={"initial_soc": state.soc})
+    payload = van.payload_kg if state.payload_kg is None else state.payload_kg
+    return problem.model_copy(
+        update={"van": van.model_copy(update={"battery": battery, "payload_kg": payload})}
+    )
+
+
+def box_start_c(problem: PlanProblem) -> float | None:
+    """The box's temperature when a van under way sets off (the set-point unless given);
+    None when it leaves the depot."""
+    state = problem.start_state
+    if state is None:
+        return None
+    if state.box_temperature_c is None:
+        return problem.van.cargo_box.setpoint_c
+    return state.box_temperature_c
+
+
+def path_tour(cost: NDArray[np.int64], time_limit_s: float, keep_order: bool) -> Tour:
+    """The shortest path from the last place of ``cost`` (the van's position) through the
+    stops to place 0 (the depot), as a tour of the places' indices from the start to the
+    depot; its cost and status are the path's."""
+    n = cost.shape[0]
+    nodes = [n - 1, *range(1, n - 1), 0]  # start, stops, depot
+    path = cost[np.ix_(nodes, nodes)].copy()
+    never = int(path.max()) * n + 1
+    depot = n - 1  # its index in ``path``
+    path[depot, :] = never
+    path[:, 0] = never
+    path[depot, 0] = 0  # the only way out of the depot: back to the start, free
+    tour = solve_tour(path, time_limit_s, keep_order)
+    order = [nodes[k] for k in tour.order[:-1]]
+    return replace(tour, order=order)
