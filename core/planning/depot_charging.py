@@ -22,7 +22,7 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 from core.params import Depot
 from core.physics.battery import JOULES_PER_KWH
@@ -59,7 +59,8 @@ def with_depot_charges(
     where the battery would not last (none when it does, or without a charger). With
     ``reorder``, each trip is then put in its own best order, kept when the day holds and is
     better on the round's objective."""
-    result = simulate_route(problem, scene, order, start, roads(order), solved, windows_s)
+    day = _Round(problem, scene, start, roads, solved, windows_s)
+    result = day.simulate(order)
     charger = problem.depot.charger
     if charger is None or result.battery.feasible:
         return result
@@ -81,15 +82,11 @@ def with_depot_charges(
         order = [*order[: cut + 1], 0, *order[cut + 1 :]]
         charges = {q + (q > cut): c for q, c in charges.items()} | {cut + 1: full}
         for fitting in range(2):  # fill, then fit every charge to what the next trip takes
-            result = simulate_route(
-                problem, scene, order, start, roads(order), solved, windows_s, charges=charges
-            )
+            result = day.simulate(order, charges)
             if fitting == 0:
                 order, charges = _without_idle(order, _fitted(problem, order, result, charges))
     if reorder is not None and charges and result.battery.feasible:
-        result = _with_trips_reordered(
-            problem, scene, order, start, roads, solved, windows_s, charges, reorder, result
-        )
+        result = _with_trips_reordered(day, order, charges, reorder, result)
     if not result.battery.feasible:
         leg = result.first_infeasible_leg
         where = f" on the way to '{result.legs[leg].to_id}'" if leg is not None else ""
@@ -102,14 +99,35 @@ def with_depot_charges(
     return result
 
 
+@dataclass(frozen=True)
+class _Round:
+    """What every simulation of the round shares; :meth:`simulate` drives one order."""
+
+    problem: PlanProblem
+    scene: Scene
+    start: dt.datetime
+    roads: Roads
+    solved: Solved
+    windows_s: Sequence[Windows] | None
+
+    def simulate(
+        self, order: list[int], charges: dict[int, DepotCharge] | None = None
+    ) -> PlanResult:
+        return simulate_route(
+            self.problem,
+            self.scene,
+            order,
+            self.start,
+            self.roads(order),
+            self.solved,
+            self.windows_s,
+            charges=charges,
+        )
+
+
 def _with_trips_reordered(
-    problem: PlanProblem,
-    scene: Scene,
+    day: _Round,
     order: list[int],
-    start: dt.datetime,
-    roads: Roads,
-    solved: Solved,
-    windows_s: Sequence[Windows] | None,
     charges: dict[int, DepotCharge],
     reorder: Reorder,
     result: PlanResult,
@@ -125,13 +143,9 @@ def _with_trips_reordered(
     shorter = [order[0], *(place for trip in trips for place in trip[1:])]
     if shorter == order:
         return result
-    first = simulate_route(
-        problem, scene, shorter, start, roads(shorter), solved, windows_s, charges=charges
-    )
-    shorter, fitted = _without_idle(shorter, _fitted(problem, shorter, first, charges))
-    again = simulate_route(
-        problem, scene, shorter, start, roads(shorter), solved, windows_s, charges=fitted
-    )
+    first = day.simulate(shorter, charges)
+    shorter, fitted = _without_idle(shorter, _fitted(day.problem, shorter, first, charges))
+    again = day.simulate(shorter, fitted)
     better = again.battery.feasible and _measure(again) < _measure(result)
     return again if better else result
 
