@@ -6,6 +6,8 @@ that the web layer can turn it into a 4xx problem response without guessing.
 
 from __future__ import annotations
 
+from typing import Any
+
 
 class CoreError(ValueError):
     """Base class of every error the core raises on bad input.
@@ -70,6 +72,30 @@ class InvalidStopsError(CoreError):
 
 class NoRouteError(InvalidStopsError):
     """A road router finds no road between two places."""
+
+
+class OffRoadError(InvalidStopsError):
+    """A place lies farther from any road than a router accepts; ``place`` is its index in
+    the places the router was given (0 the depot, then the stops), for the planner to name
+    a place beyond the stops (:func:`off_road`)."""
+
+    place: int | None = None
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        return _off_road_at, (self.message, self.field, self.details, self.place)
+
+
+def off_road(message: str, place: int) -> OffRoadError:
+    """The error of place ``place`` (by index) off the road, naming the depot or its stop."""
+    return _off_road_at(message, "depot" if place == 0 else f"stops[{place - 1}]", None, place)
+
+
+def _off_road_at(
+    message: str, field: str | None, details: list[tuple[str, str]] | None, place: int | None
+) -> OffRoadError:
+    error = OffRoadError(message, field, details)
+    error.place = place
+    return error
 
 
 class LimitExceededError(CoreError):

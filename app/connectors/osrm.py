@@ -18,15 +18,11 @@ from typing import Any
 import httpx
 import numpy as np
 
-from core.exceptions import InvalidStopsError, NoRouteError, ServiceUnavailableError
+from core.exceptions import NoRouteError, ServiceUnavailableError, off_road
 from core.params import Place
 from core.routing.roads import LegRoute, RoadTable, bearing_deg
 
 SERVICE = "osrm"
-
-
-def _field(index: int) -> str:
-    return "depot" if index == 0 else f"stops[{index - 1}]"
 
 
 class OsrmRouter:
@@ -102,10 +98,10 @@ class OsrmRouter:
         far = np.flatnonzero(snap > self.max_snap_m)
         if far.size:
             k = int(far[0])
-            raise InvalidStopsError(
+            raise off_road(
                 f"'{places[k].id}' ({places[k].lat}, {places[k].lon}) is {snap[k]:,.0f} m from "
                 f"the nearest road; at most {self.max_snap_m:g} m is accepted",
-                _field(k),
+                k,
             )
         # A pair with no road stays NaN (OSRM's null): a plan names the stop, a fleet plan
         # leaves it out as unreachable.

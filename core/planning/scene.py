@@ -7,6 +7,7 @@ import datetime as dt
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from core.exceptions import InvalidStopsError, OffRoadError
 from core.params import Place
 from core.physics.weather import Forecast, WeatherService, forecast_for
 from core.planning.model import RoundFields
@@ -35,7 +36,12 @@ def legs_for(
     """Every ordered pair's leg between ``places`` (by default the depot and the stops): the
     client's matrix, else the router's table, else the estimate."""
     places = problem.places if places is None else places
-    table = router.table(places) if router is not None and problem.matrix is None else None
+    try:
+        table = router.table(places) if router is not None and problem.matrix is None else None
+    except OffRoadError as error:
+        if error.place is None or error.place <= len(problem.stops):
+            raise
+        raise InvalidStopsError(error.message, "start_state") from None  # the van's position
     return build_legs(places, problem.matrix, table)
 
 

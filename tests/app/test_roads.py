@@ -152,6 +152,23 @@ def test_a_stop_in_the_sea_is_named(roads):
     assert error["field"] == "stops[2]" and "nearest road" in error["message"]
 
 
+def test_a_van_in_the_sea_is_named_as_its_start_state(roads):
+    at_sea = {"lat": 43.70, "lon": 7.45, "time": "2026-07-15T12:00:00+02:00", "soc": 0.8}
+    body = monaco_plan(["moneghetti", "casino", "palais"], start_state=at_sea)
+    response = roads.post("/v1/plans", json=body)
+    assert response.status_code == 422
+    error = response.json()["errors"][0]
+    assert error["field"] == "start_state" and "nearest road" in error["message"]
+    # from a street, the rest of the day drives on OSRM's roads
+    on_land = at_sea | {"lat": PLACES["casino"][0], "lon": PLACES["casino"][1]}
+    planned = roads.post(
+        "/v1/plans", json=monaco_plan(["moneghetti", "palais"], start_state=on_land)
+    )
+    assert planned.status_code == 200
+    assert planned.json()["tour"][0] == "start"
+    assert planned.json()["distance_source"] == "osrm"
+
+
 # Two road islands 3 km apart with no road between them, as OpenStreetMap XML (osrm-extract
 # reads .osm as well as .osm.pbf).
 ISLANDS_OSM = """<?xml version="1.0" encoding="UTF-8"?>

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import pickle
 
-from core.exceptions import CoreError, InvalidParameterError, LimitExceededError
+from core.exceptions import (
+    CoreError,
+    InvalidParameterError,
+    LimitExceededError,
+    OffRoadError,
+    off_road,
+)
 
 
 def test_under_a_prefix_every_entry_is_kept():
@@ -47,3 +53,10 @@ def test_errors_cross_processes_with_their_fields():
         error.field,
         error.details,
     )
+
+
+def test_an_off_road_place_crosses_processes_with_its_index():
+    error = off_road("'x' is 900 m from the nearest road", 3)
+    again = pickle.loads(pickle.dumps(error))
+    assert (type(again), again.field, again.place) == (OffRoadError, "stops[2]", 3)
+    assert off_road("the depot", 0).field == "depot"
