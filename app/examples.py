@@ -44,8 +44,8 @@ PLAN_EXAMPLE: dict[str, Any] = {
 }
 
 # A long summer day of one van: 40 stops spread over 15 km around the centre (a golden-angle
-# spiral), about 60 kWh with the refrigeration at 31 °C — more than its 40 kWh. The depot's
-# 22 kW charger brings it back at noon to charge what the afternoon needs.
+# spiral), about 70 kWh with the refrigeration at 31 °C — far more than its 40 kWh. The depot's
+# 22 kW charger brings it back twice in the afternoon to charge what the rest needs.
 _GOLDEN_ANGLE = math.pi * (3 - math.sqrt(5))
 CHARGING_PLAN_EXAMPLE: dict[str, Any] = {
     "date": "2026-07-15",

@@ -61,7 +61,7 @@ async def create_plan(
                     "value": PLAN_EXAMPLE,
                 },
                 "vienna-40-stops-depot-charger": {
-                    "summary": "A summer day longer than the battery: a noon charge at the depot",
+                    "summary": "A summer day longer than the battery: it charges at the depot",
                     "value": CHARGING_PLAN_EXAMPLE,
                 },
             }
