@@ -78,6 +78,26 @@ CHARGING_PLAN_EXAMPLE: dict[str, Any] = {
     "weather": {"t_min_c": 21, "t_max_c": 31},
 }
 
+# The same day with no charger at the depot and two on the way: a 150 kW one in the Prater
+# (open 06:00–22:00) and an 11 kW one beside the depot. The fast one wins: it stops there
+# between stops.
+EN_ROUTE_CHARGING_EXAMPLE: dict[str, Any] = CHARGING_PLAN_EXAMPLE | {
+    "depot": {"id": "depot-centre", "lat": 48.21, "lon": 16.37},
+    "chargers": [
+        {
+            "id": "hpc-prater",
+            "lat": 48.215,
+            "lon": 16.40,
+            "power_kw": 150,
+            "points": 4,
+            "price_per_kwh": 0.59,
+            "plug_minutes": 2,
+            "opening_hours": [{"start": "06:00", "end": "22:00"}],
+        },
+        {"id": "ac-slow", "lat": 48.212, "lon": 16.372, "power_kw": 11, "price_per_kwh": 0.35},
+    ],
+}
+
 # The same day's stops for a fleet of two, with the shops' receiving windows: the bakery café
 # and the pharmacy take goods before they open, the supermarkets in the late morning.
 _WINDOWS = {

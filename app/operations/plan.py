@@ -128,10 +128,10 @@ def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> Plan
                 },
             )
         )
-    for charge in result.charges:  # at the depot, the only charger a round visits yet
+    for charge in result.charges:
         features.append(
             Feature(
-                geometry=Point(coordinates=(depot_lon, depot_lat)),
+                geometry=Point(coordinates=(charge.lon, charge.lat)),
                 properties={"kind": "charge"} | ChargeOut(**vars(charge)).model_dump(mode="json"),
             )
         )

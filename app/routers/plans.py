@@ -8,7 +8,7 @@ from fastapi import APIRouter, Body, Header, Request
 from fastapi.responses import JSONResponse
 
 from app.deps import ExecutorDep, SettingsDep
-from app.examples import CHARGING_PLAN_EXAMPLE, PLAN_EXAMPLE
+from app.examples import CHARGING_PLAN_EXAMPLE, EN_ROUTE_CHARGING_EXAMPLE, PLAN_EXAMPLE
 from app.operations.plan import plan_geojson, plan_response, run_plan
 from app.schemas.plans import PlanRequest, PlanResponse
 
@@ -63,6 +63,10 @@ async def create_plan(
                 "vienna-40-stops-depot-charger": {
                     "summary": "A summer day longer than the battery: it charges at the depot",
                     "value": CHARGING_PLAN_EXAMPLE,
+                },
+                "vienna-40-stops-chargers-on-the-way": {
+                    "summary": "The same day with chargers on the way: it stops at the fast one",
+                    "value": EN_ROUTE_CHARGING_EXAMPLE,
                 },
             }
         ),

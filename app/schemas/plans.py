@@ -95,7 +95,9 @@ class StopOut(ApiModel):
 class ChargeOut(ApiModel):
     """One charge of the round, where it happens in the timeline."""
 
-    charger_id: str = Field(..., description='Where: "depot" for the depot\'s charger.')
+    charger_id: str = Field(
+        ..., description="Where: a charger's id, or \"depot\" for the depot's charger."
+    )
     arrive: dt.datetime = Field(..., description="Arrival at the charger, local time.")
     depart: dt.datetime = Field(
         ..., description="Departure, plugging in and out included, local time."
@@ -110,6 +112,8 @@ class ChargeOut(ApiModel):
     battery_kwh: float = Field(..., description="Energy stored in the battery [kWh].")
     minutes: float = Field(..., description="Minutes charging (plugging in and out aside).")
     cost: float = Field(..., description="grid_kwh at the charger's price_per_kwh.")
+    lat: float = Field(..., description="The charger's latitude [°].")
+    lon: float = Field(..., description="The charger's longitude [°].")
 
 
 class BreakOut(ApiModel):
@@ -161,13 +165,13 @@ class PlanResponse(ApiModel):
     tour: list[str] = Field(
         ...,
         description='Ids in driving order, depot first and last ("start", the van\'s position, '
-        "first with start_state); the depot between is a return to charge.",
+        "first with start_state); a charger's id (or the depot) between stops is a charge.",
     )
     legs: list[LegOut] = Field(..., description="The driven legs, in order.")
     stops: list[StopOut] = Field(..., description="The stops, in visiting order.")
     charges: list[ChargeOut] = Field(
         default_factory=list,
-        description="The charges between stops (the tour shows each return to the depot), in "
+        description="The charges between stops (the tour shows each charger visited), in "
         "order; the legs' and stops' states of charge and the battery verdict include them.",
     )
     breaks: list[BreakOut] = Field(

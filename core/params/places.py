@@ -26,6 +26,42 @@ class Place(Params):
     )
 
 
+class TimeWindow(Params):
+    """A span of local time on the round's date: when a stop takes deliveries (service starts
+    inside) or a charger is open."""
+
+    start: ClockTime = Field(..., description="Opens, local HH:MM.")
+    end: ClockTime = Field(..., description="Closes, local HH:MM; after start.")
+
+    @field_validator("end")
+    @classmethod
+    def _after_start(cls, value: dt.time, info: ValidationInfo) -> dt.time:
+        if "start" in info.data and value <= info.data["start"]:
+            raise ValueError("end must be after start")
+        return value
+
+
+def windows_in_order(value: list[TimeWindow]) -> list[TimeWindow]:
+    """``value`` when its windows are sorted and do not overlap; else the error names the
+    window that starts too early."""
+    for k in range(1, len(value)):
+        if value[k].start < value[k - 1].end:
+            rule = PydanticCustomError(
+                "windows_in_order",
+                "starts at {start}, before window {previous} ends ({end}); windows must be "
+                "sorted and must not overlap",
+                {
+                    "start": f"{value[k].start:%H:%M}",
+                    "previous": k - 1,
+                    "end": f"{value[k - 1].end:%H:%M}",
+                },
+            )
+            raise ValidationError.from_exception_data(
+                "TimeWindow", [InitErrorDetails(type=rule, loc=(k, "start"), input=None)]
+            )
+    return value
+
+
 #: Most minutes to plug in, start and unplug a charge.
 MAX_PLUG_MINUTES = 120.0
 
@@ -62,20 +98,6 @@ class Depot(Place):
     )
 
 
-class TimeWindow(Params):
-    """When a stop takes deliveries, local time on the round's date: service starts inside."""
-
-    start: ClockTime = Field(..., description="Opens, local HH:MM.")
-    end: ClockTime = Field(..., description="Closes, local HH:MM; after start.")
-
-    @field_validator("end")
-    @classmethod
-    def _after_start(cls, value: dt.time, info: ValidationInfo) -> dt.time:
-        if "start" in info.data and value <= info.data["start"]:
-            raise ValueError("end must be after start")
-        return value
-
-
 #: Most time windows of one stop.
 MAX_TIME_WINDOWS = 8
 #: Most stops of one request any server takes; a server's own limit (``COLDROUTE_MAX_STOPS``)
@@ -103,22 +125,7 @@ class Stop(Place):
     @field_validator("time_windows")
     @classmethod
     def _windows_in_order(cls, value: list[TimeWindow]) -> list[TimeWindow]:
-        for k in range(1, len(value)):
-            if value[k].start < value[k - 1].end:
-                rule = PydanticCustomError(
-                    "windows_in_order",
-                    "starts at {start}, before window {previous} ends ({end}); windows must be "
-                    "sorted and must not overlap",
-                    {
-                        "start": f"{value[k].start:%H:%M}",
-                        "previous": k - 1,
-                        "end": f"{value[k - 1].end:%H:%M}",
-                    },
-                )
-                raise ValidationError.from_exception_data(
-                    "TimeWindow", [InitErrorDetails(type=rule, loc=(k, "start"), input=None)]
-                )
-        return value
+        return windows_in_order(value)
 
     @field_validator("door_open_s")
     @classmethod
@@ -126,6 +133,34 @@ class Stop(Place):
         if "service_time_s" in info.data and value > info.data["service_time_s"]:
             raise ValueError("door_open_s must not exceed service_time_s")
         return value
+
+
+#: Most chargers on the way one request may list.
+MAX_CHARGERS = 200
+
+
+class Charger(Place, ChargePoint):
+    """Charge points on the way: a van whose battery would not last drives there between
+    stops and charges what the rest of its day needs."""
+
+    id: str = Field(
+        ...,
+        min_length=1,
+        max_length=64,
+        description='Identifier of the charger, unique among the places ("depot" names the '
+        "depot's own charger).",
+    )
+    opening_hours: list[TimeWindow] = Field(
+        default_factory=list,
+        max_length=MAX_TIME_WINDOWS,
+        description="When vans may charge (local time on the round's date), sorted and not "
+        "overlapping: a van waits for the opening and unplugs at the closing. Empty: always.",
+    )
+
+    @field_validator("opening_hours")
+    @classmethod
+    def _hours_in_order(cls, value: list[TimeWindow]) -> list[TimeWindow]:
+        return windows_in_order(value)
 
 
 #: Longest leg a matrix may hold: 100,000 km and 30 days (beyond, the numbers are mistakes).

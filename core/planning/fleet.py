@@ -32,7 +32,6 @@ from core.exceptions import CoreError, InvalidParameterError
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import WeatherService, forecast_for
 from core.planning.day import FleetDay, VanShift, fleet_day, leg_roads
-from core.planning.depot_charging import charging_not_planned
 from core.planning.estimates import LearnedTimes
 from core.planning.explain import explain
 from core.planning.feasibility import Feasibility
@@ -47,6 +46,7 @@ from core.planning.model import (
     check_stop_ids,
     fields_of,
 )
+from core.planning.recharge import charging_not_planned
 from core.planning.repair import Repaired, fitting, repair
 from core.planning.scene import Scene, legs_for
 from core.planning.solver_input import routing_input
@@ -129,7 +129,7 @@ def plan_fleet(
         verification_rounds=routed.verification_rounds,
         timezone=timezone_name,
         distance_source=legs.source,
-        warnings=[*day_weather[1], *charging_not_planned(problem.depot)],
+        warnings=[*day_weather[1], *charging_not_planned(problem)],
     )
 
 

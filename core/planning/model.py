@@ -16,8 +16,10 @@ from pydantic import Discriminator, Field, Tag, ValidationInfo, field_validator
 from core.exceptions import InvalidStopsError
 from core.params import (
     BRANCH_TAG,
+    MAX_CHARGERS,
     MAX_STOPS,
     NORMAL_DRIVER,
+    Charger,
     ClockTime,
     Depot,
     IsoDate,
@@ -38,6 +40,8 @@ from core.physics.weather import DayWeather, WeatherSource
 from core.routing.geo import DistanceSource
 from core.routing.tsp import SolverStatus
 
+#: How the answers name the depot's charger.
+DEPOT_CHARGER_ID = "depot"
 #: Longest round the planner simulates [s] (a week): longer inputs are mistakes.
 MAX_ROUND_S = 7 * 86_400.0
 #: Most vans in one fleet plan.
@@ -91,6 +95,13 @@ class RoundFields(Params):
     objective: Objective = Field("distance", description="What the tour minimises.")
     matrix: RoadMatrix | None = Field(
         None, description="Road distances/durations from your router: depot first, then stops."
+    )
+    chargers: list[Charger] = Field(
+        default_factory=list,
+        max_length=MAX_CHARGERS,
+        description="Charge points on the way (besides depot.charger): a round whose battery "
+        "would not last visits them between stops, as often as it needs, and charges what the "
+        "rest of its day needs. Rounds without time windows and without a client matrix.",
     )
 
     @property
@@ -268,17 +279,22 @@ class FleetProblem(FleetFields):
     vehicles: list[FleetVehicle] = vehicles_field()
 
 
-def check_stop_ids(depot: Depot, stops: Sequence[Stop]) -> None:
-    """Every stop's id is its own (and not the depot's); else an error naming the second."""
-    seen: dict[str, int] = {depot.id: -1}
-    for index, stop in enumerate(stops):
-        if stop.id in seen:
-            other = "the depot" if seen[stop.id] < 0 else f"stops[{seen[stop.id]}]"
-            raise InvalidStopsError(
-                f"stop id '{stop.id}' is used twice (also by {other}); ids must be unique",
-                f"stops[{index}].id",
-            )
-        seen[stop.id] = index
+def check_stop_ids(depot: Depot, stops: Sequence[Stop], chargers: Sequence[Charger] = ()) -> None:
+    """Every stop's and charger's id is its own (not the depot's, and no charger is called
+    "depot", the name of the depot's charger in the answers); else an error naming the
+    second."""
+    seen = {depot.id: "the depot"}
+    for name, places in (("stops", stops), ("chargers", chargers)):
+        for index, place in enumerate(places):
+            other = seen.get(place.id)
+            if other is None and name == "chargers" and place.id == DEPOT_CHARGER_ID:
+                other = "the depot's charger"
+            if other is not None:
+                raise InvalidStopsError(
+                    f"id '{place.id}' is used twice (also by {other}); ids must be unique",
+                    f"{name}[{index}].id",
+                )
+            seen[place.id] = f"{name}[{index}]"
 
 
 def place_field(index: int) -> str:
@@ -335,7 +351,7 @@ class ChargeResult:
     """One charge of the round: where (``charger_id``, "depot" for the depot's), when, the
     state of charge before and after [–], the energy drawn from the grid for the battery and
     the consumers meanwhile and the energy stored in the battery [kWh], the minutes plugged
-    in, and what the grid energy costs at the charger's price."""
+    in, what the grid energy costs at the charger's price, and where the charger is [°]."""
 
     charger_id: str
     arrive: dt.datetime
@@ -346,6 +362,8 @@ class ChargeResult:
     battery_kwh: float
     minutes: float
     cost: float
+    lat: float
+    lon: float
 
 
 @dataclass(frozen=True)

@@ -12,15 +12,21 @@ from __future__ import annotations
 
 import datetime as dt
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.typing import NDArray
 
 from core.clock import check_representable, departure
-from core.exceptions import InvalidStopsError, LimitExceededError, NoRouteError
+from core.exceptions import (
+    InvalidParameterError,
+    InvalidStopsError,
+    LimitExceededError,
+    NoRouteError,
+)
+from core.params import Place
 from core.physics.weather import WeatherService
 from core.planning.day import VanShift, fleet_day, leg_roads
-from core.planning.depot_charging import charging_not_planned, with_depot_charges
 from core.planning.estimates import cost_matrix
 from core.planning.fleet import search
 from core.planning.model import (
@@ -30,21 +36,17 @@ from core.planning.model import (
     Solved,
     check_stop_ids,
 )
-from core.planning.scene import Scene, legs_for, weather_service_for
-from core.planning.start_state import (
-    check_start,
-    path_tour,
-    round_places,
-    under_way,
-)
+from core.planning.recharge import charging_not_planned, with_charges
+from core.planning.scene import Scene, legs_for, round_field, round_places, weather_service_for
+from core.planning.start_state import check_start, path_tour, under_way
 from core.planning.timeline import client_legs_too_fast, windows_after
 from core.routing.geo import Legs, build_legs
 from core.routing.roads import LegRoute, RememberingRouter, RoadRouter
-from core.routing.tsp import solve_tour
+from core.routing.tsp import Tour, solve_path, solve_tour
 from core.routing.units import payload_units_down, payload_units_up
 
-#: Search budget for each trip of a round that comes back to charge [s]: trips are short
-#: enough for CP-SAT's proof within it.
+#: Search budget for each stretch between charges of a round [s]: stretches are short enough
+#: for CP-SAT's proof within it.
 TRIP_TIME_LIMIT_S = 0.2
 
 
@@ -75,7 +77,7 @@ def plan(
     problem = under_way(problem)
     places = round_places(problem)
     legs = legs_for(problem, router, places)
-    _check_reachable(problem, legs)
+    _check_reachable(problem, places, legs)
     too_fast = client_legs_too_fast(legs, problem.van.vehicle.max_acceleration_mps2)
     scene = Scene(
         places,
@@ -88,10 +90,8 @@ def plan(
     if windowed and not problem.keep_order:
         return _in_windows(problem, scene, start, router, started)
     cost, unit_value, offset = cost_matrix(problem, legs, start)
-    if problem.start_state is None:
-        tour = solve_tour(cost, problem.time_limit_s, problem.keep_order)
-    else:
-        tour = path_tour(cost, problem.time_limit_s, problem.keep_order)
+    tours = _Tours(cost, len(places) - len(problem.chargers), problem.start_state is not None)
+    tour = tours.first(problem.time_limit_s, problem.keep_order)
     order = tour.order
     round_s = float(legs.duration_s[order[:-1], order[1:]].sum()) + sum(
         stop.service_time_s for stop in problem.stops
@@ -110,12 +110,7 @@ def plan(
             return None
         return leg_roads(remembering, scene.places, driven)
 
-    def reorder(trip: list[int]) -> list[int]:
-        places = trip[:-1]
-        best = solve_tour(cost[np.ix_(places, places)], TRIP_TIME_LIMIT_S)
-        return [places[k] for k in best.order]
-
-    result = with_depot_charges(
+    result = with_charges(
         problem,
         scene,
         order,
@@ -123,7 +118,7 @@ def plan(
         roads,
         Solved(tour.status, tour.cost * unit_value + offset * (len(order) - 1), tour.runtime_s),
         windows_after(problem.stops, problem.date, start) if windowed else None,
-        None if problem.keep_order else reorder,
+        None if problem.keep_order else tours,
     )
     if result.late_stops:  # the client's own order misses a window
         late = result.late_stops[0]
@@ -136,6 +131,44 @@ def plan(
             f"stops[{index}].time_windows",
         )
     return result
+
+
+@dataclass(frozen=True)
+class _Tours:
+    """The round's orders on the solver's ``cost`` (every place: the depot, the stops, the
+    van's position when under way, then the chargers): the places up to ``visited`` are the
+    round's, the chargers after them are visited as the battery needs."""
+
+    cost: NDArray[np.int64]
+    visited: int
+    under_way: bool
+
+    def first(self, time_limit_s: float, keep_order: bool) -> Tour:
+        """The round without charging: a round trip, or from the van's position to the depot."""
+        cost = self.cost[: self.visited, : self.visited]
+        if self.under_way:
+            return path_tour(cost, time_limit_s, keep_order)
+        return solve_tour(cost, time_limit_s, keep_order)
+
+    def stretch(self, places: list[int]) -> list[int]:
+        return solve_path(self.cost, places, TRIP_TIME_LIMIT_S).order
+
+    def through(self, chargers: list[int]) -> list[int]:
+        """The round again with a visit to each of ``chargers`` (a place listed twice, twice),
+        never one right after another or at the depot."""
+        nodes = [*range(self.visited), *chargers]
+        cost = self.cost[np.ix_(nodes, nodes)].copy()
+        never = int(cost.max()) * len(nodes) + 1
+        cost[self.visited :, self.visited :] = never
+        cost[self.visited :, 0] = never
+        cost[0, self.visited :] = never
+        if self.under_way:
+            start = self.visited - 1
+            ends = [start, *range(1, start), *range(self.visited, len(nodes)), 0]
+            path = solve_path(cost, ends, TRIP_TIME_LIMIT_S * len(chargers)).order
+        else:
+            path = solve_tour(cost, TRIP_TIME_LIMIT_S * len(chargers)).order
+        return [nodes[k] for k in path]
 
 
 def _in_windows(
@@ -164,21 +197,16 @@ def _in_windows(
             field or f"stops[{index}]",
         )
     result = routed.stamped(time.perf_counter() - started)[0].plan
-    return replace(result, warnings=[*result.warnings, *charging_not_planned(problem.depot)])
+    return replace(result, warnings=[*result.warnings, *charging_not_planned(problem)])
 
 
-def _check_reachable(problem: PlanProblem, legs: Legs) -> None:
-    """Every stop (and the van's position) can be driven to from the depot and back (a router
-    may find no road)."""
+def _check_reachable(problem: PlanProblem, places: list[Place], legs: Legs) -> None:
+    """Every stop (the van's position, each charger) can be driven to from the depot and
+    back (a router may find no road)."""
     for index in legs.unreachable():
-        if index > len(problem.stops):
-            raise NoRouteError(
-                f"no road links the van's position with the depot '{problem.depot.id}'",
-                "start_state",
-            )
         raise NoRouteError(
-            f"no road links '{problem.stops[index - 1].id}' with the depot '{problem.depot.id}'",
-            f"stops[{index - 1}]",
+            f"no road links '{places[index].id}' with the depot '{problem.depot.id}'",
+            round_field(problem, places, index),
         )
 
 
@@ -187,7 +215,13 @@ def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
     payload, the time zone and start time, the client's matrix. Raises
     :class:`core.exceptions.CoreError` naming the field; returns the departure and the zone's
     name."""
-    check_stop_ids(problem.depot, problem.stops)
+    check_stop_ids(problem.depot, problem.stops, problem.chargers)
+    if problem.chargers and problem.matrix is not None:
+        raise InvalidParameterError(
+            "a client matrix has no rows for the chargers on the way: leave out matrix (the "
+            "planner estimates the legs or asks its router) or chargers",
+            "chargers",
+        )
     # In the solver's units, so that a round accepted here fits the solver's payload too.
     delivered = sum(stop.delivery_kg for stop in problem.stops)
     taken = int(payload_units_up([stop.delivery_kg for stop in problem.stops]).sum())

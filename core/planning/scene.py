@@ -1,5 +1,6 @@
 """What every simulation of one day shares — the places, their legs, the zone and the weather
-(:class:`Scene`) — and where the legs come from (:func:`legs_for`)."""
+(:class:`Scene`) — which places a round has (:func:`round_places`) and where their legs come
+from (:func:`legs_for`)."""
 
 from __future__ import annotations
 
@@ -8,9 +9,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from core.exceptions import InvalidStopsError, OffRoadError
-from core.params import Place
+from core.params import ChargePoint, Place
 from core.physics.weather import Forecast, WeatherService, forecast_for
-from core.planning.model import RoundFields
+from core.planning.model import PlanProblem, RoundFields
+from core.planning.start_state import START_ID
 from core.routing.geo import Legs, build_legs
 from core.routing.roads import RoadRouter
 
@@ -30,6 +32,37 @@ class Scene:
     notes: tuple[str, ...] = ()
 
 
+def round_places(problem: PlanProblem) -> list[Place]:
+    """The places of a round by index: the depot (0), the stops, the van's position when the
+    day starts under way, then the chargers on the way."""
+    state = problem.start_state
+    start = [] if state is None else [Place(id=START_ID, lat=state.lat, lon=state.lon)]
+    return [*problem.places, *start, *problem.chargers]
+
+
+def charge_points(problem: PlanProblem) -> dict[int, ChargePoint]:
+    """Where a round may charge, by place index (:func:`round_places`): the depot's charger
+    and the chargers on the way."""
+    first = len(problem.stops) + 1 + (problem.start_state is not None)
+    points: dict[int, ChargePoint] = {first + k: c for k, c in enumerate(problem.chargers)}
+    if problem.depot.charger is not None:
+        points[0] = problem.depot.charger
+    return points
+
+
+def round_field(problem: RoundFields, places: list[Place], index: int) -> str:
+    """The request field of place ``index`` of ``places`` (the depot, a stop, the van's
+    position or a charger on the way)."""
+    if index == 0:
+        return "depot"
+    if index <= len(problem.stops):
+        return f"stops[{index - 1}]"
+    first_charger = len(places) - len(problem.chargers)
+    if index < first_charger:
+        return "start_state"
+    return f"chargers[{index - first_charger}]"
+
+
 def legs_for(
     problem: RoundFields, router: RoadRouter | None, places: list[Place] | None = None
 ) -> Legs:
@@ -41,7 +74,7 @@ def legs_for(
     except OffRoadError as error:
         if error.place is None or error.place <= len(problem.stops):
             raise
-        raise InvalidStopsError(error.message, "start_state") from None  # the van's position
+        raise InvalidStopsError(error.message, round_field(problem, places, error.place)) from None
     return build_legs(places, problem.matrix, table)
 
 

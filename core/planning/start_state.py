@@ -2,34 +2,24 @@
 position, at its time, with its charge, box temperature and payload, serves the stops left and
 returns to the depot.
 
-The van's position is one more place after the stops (:func:`round_places`); the order is the
-shortest path from it through every stop to the depot, solved as a round trip on a matrix
-where the only way out of the depot leads back to the start at no cost (:func:`path_tour`).
+The van's position is one more place after the stops (:func:`core.planning.scene.round_places`);
+the order is the shortest path from it through every stop to the depot (:func:`path_tour`).
 """
 
 from __future__ import annotations
 
 import datetime as dt
-from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from core.exceptions import InvalidParameterError
-from core.params import MIN_SOC_WINDOW, Place
+from core.params import MIN_SOC_WINDOW
 from core.planning.model import PlanProblem
-from core.routing.tsp import Tour, solve_tour
+from core.routing.tsp import Tour, solve_path
 
 #: The id of the van's position in the tour and the legs.
 START_ID = "start"
-
-
-def round_places(problem: PlanProblem) -> list[Place]:
-    """The depot, the stops, and the van's position when the day starts under way."""
-    state = problem.start_state
-    if state is None:
-        return problem.places
-    return [*problem.places, Place(id=START_ID, lat=state.lat, lon=state.lon)]
 
 
 def check_start(problem: PlanProblem, zone: dt.tzinfo | None) -> dt.datetime | None:
@@ -102,13 +92,4 @@ def path_tour(cost: NDArray[np.int64], time_limit_s: float, keep_order: bool) ->
     stops to place 0 (the depot), as a tour of the places' indices from the start to the
     depot; its cost and status are the path's."""
     n = cost.shape[0]
-    nodes = [n - 1, *range(1, n - 1), 0]  # start, stops, depot
-    path = cost[np.ix_(nodes, nodes)].copy()
-    never = int(path.max()) * n + 1
-    depot = n - 1  # its index in ``path``
-    path[depot, :] = never
-    path[:, 0] = never
-    path[depot, 0] = 0  # the only way out of the depot: back to the start, free
-    tour = solve_tour(path, time_limit_s, keep_order)
-    order = [nodes[k] for k in tour.order[:-1]]
-    return replace(tour, order=order)
+    return solve_path(cost, [n - 1, *range(1, n - 1), 0], time_limit_s, keep_order)

@@ -125,13 +125,16 @@ class Break:
 
 
 @dataclass(frozen=True)
-class DepotCharge:
-    """A return to the depot between stops to charge: the minutes to plug in and out and
-    the charge itself [s], at a charger of ``power_kw``."""
+class ChargeVisit:
+    """A stop at a charger between stops (the depot's or one on the way): the minutes to plug
+    in and out and the charge itself [s], at a point of ``power_kw``, open during ``open_s``
+    (seconds after the departure; empty: always). The van waits for the opening; the charge
+    ends at the closing at the latest."""
 
     plug_s: float
     charge_s: float
     power_kw: float
+    open_s: Windows = ()
 
 
 @dataclass(frozen=True)
@@ -270,6 +273,7 @@ class Timeline:
     geometry: list[list[tuple[float, float]]]
     capped_s: float = 0.0
     charging: list[ChargingSpell] = field(default_factory=list)
+    charged_at: list[int] = field(default_factory=list)
     breaks: list[Break] = field(default_factory=list)
 
     @property
@@ -298,6 +302,7 @@ class _Builder:
     geometry: list[list[tuple[float, float]]] = field(default_factory=list)
     capped_s: float = 0.0
     charging: list[ChargingSpell] = field(default_factory=list)
+    charged_at: list[int] = field(default_factory=list)
     rest: Rest = field(default_factory=Rest)
     driving_s: float = 0.0
     breaks: list[Break] = field(default_factory=list)
@@ -385,15 +390,28 @@ class _Builder:
         self.payload_kg = max(self.payload_kg - stop.delivery_kg, 0.0)
         self.stand(dwell, self.payload_kg)
 
-    def charge(self, visit: DepotCharge) -> None:
-        """Stand at the depot: plug in, charge for ``visit.charge_s``, unplug."""
+    def charge(self, position: int, visit: ChargeVisit) -> None:
+        """Stand at a charger (place ``position`` of the order): wait for it to open, plug in,
+        charge for ``visit.charge_s`` (until it closes at the latest), unplug. A charger
+        closed for the rest of the day charges nothing."""
         plug = math.ceil(visit.plug_s / 2 / PLAN_DT_S)
-        charge = math.ceil(visit.charge_s / PLAN_DT_S)
-        arrival_s = self.clock * PLAN_DT_S
-        self.parked.append(Interval(start_s=arrival_s, duration_s=(2 * plug + charge) * PLAN_DT_S))
-        self.stand(plug, self.payload_kg)
+        arrival = self.clock
+        hours = next_window(arrival * PLAN_DT_S, visit.open_s)
+        wait, charge = 0, math.ceil(visit.charge_s / PLAN_DT_S)
+        if hours is None:
+            charge = 0
+        else:
+            wait = math.ceil(max(hours[0] / PLAN_DT_S - arrival, 0.0))
+            if math.isfinite(hours[1]):
+                left = math.floor(hours[1] / PLAN_DT_S - arrival - wait - 2 * plug)
+                charge = max(min(charge, left), 0)
+        self.parked.append(
+            Interval(start_s=arrival * PLAN_DT_S, duration_s=(wait + 2 * plug + charge) * PLAN_DT_S)
+        )
+        self.stand(wait + plug, self.payload_kg)
         self.marks["serve"].append(self.clock)
         if charge:
+            self.charged_at.append(position)
             self.charging.append(
                 ChargingSpell(
                     start_s=self.clock * PLAN_DT_S,
@@ -402,8 +420,8 @@ class _Builder:
                 )
             )
         self.stand(charge + plug, self.payload_kg)
-        if self.rest.eu_561 and charge * PLAN_DT_S >= EU_BREAK_S:  # charged during the break
-            self.counts_as_break(self.clock - charge - plug, "eu-561")
+        if self.rest.eu_561 and (self.clock - arrival) * PLAN_DT_S >= EU_BREAK_S:
+            self.counts_as_break(arrival, "eu-561")  # charged (or waited) during the break
 
     def finish(self) -> Timeline:
         marks = {name: np.array(values) for name, values in self.marks.items()}
@@ -423,6 +441,7 @@ class _Builder:
             geometry=self.geometry,
             capped_s=self.capped_s,
             charging=self.charging,
+            charged_at=self.charged_at,
             breaks=self.breaks,
         )
 
@@ -434,12 +453,12 @@ def build_timeline(
     order: list[int],
     routes: list[LegRoute] | None,
     windows_s: Sequence[Windows] | None = None,
-    charges: Mapping[int, DepotCharge] | None = None,
+    charges: Mapping[int, ChargeVisit] | None = None,
     rest: Rest | None = None,
 ) -> Timeline:
     """Speed, grade, payload and heading of every sample of the day, the door openings, the
-    stops and the marks, for the places in ``order`` (depot first and last; the depot
-    between, the van comes back to charge as ``charges`` says, by position in ``order``). With
+    stops and the marks, for the places in ``order`` (depot first and last; the van charges
+    at the depot or a charger between stops as ``charges`` says, by position in ``order``). With
     ``windows_s`` (each place's time windows, seconds after the departure) the van waits,
     parked with the door shut, for a stop's window to open; a stop reached after its last
     window closes is served at once and listed in ``late``. ``rest``: the driver's breaks,
@@ -461,10 +480,10 @@ def build_timeline(
             else [(a.lon, a.lat), (b.lon, b.lat)]
         )
         day.drive(leg.speed_mps, leg.heading_deg, float(legs.grade[i, j]))
-        if j != 0:
+        if 0 < j <= len(problem.stops):
             day.serve(j, problem.stops[j - 1], windows_s[j] if windows_s is not None else ())
         elif charges is not None and k + 1 in charges:
-            day.charge(charges[k + 1])
+            day.charge(k + 1, charges[k + 1])
         else:
             day.marks["serve"].append(day.clock)
         day.marks["leave"].append(day.clock)

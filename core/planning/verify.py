@@ -19,6 +19,7 @@ from core.physics.battery import JOULES_PER_KWH
 from core.physics.cycles import trace_distance_m
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate
 from core.planning.model import (
+    DEPOT_CHARGER_ID,
     BreakResult,
     ChargeResult,
     DayProfile,
@@ -29,11 +30,11 @@ from core.planning.model import (
     StopResult,
     UnassignedReason,
 )
-from core.planning.scene import Scene
+from core.planning.scene import Scene, charge_points
 from core.planning.start_state import box_start_c
 from core.planning.timeline import (
     PLAN_DT_S,
-    DepotCharge,
+    ChargeVisit,
     Timeline,
     Windows,
     build_timeline,
@@ -55,7 +56,7 @@ def simulate_route(
     solved: Solved,
     windows_s: Sequence[Windows] | None = None,
     latest_return_s: float | None = None,
-    charges: Mapping[int, DepotCharge] | None = None,
+    charges: Mapping[int, ChargeVisit] | None = None,
 ) -> PlanResult:
     """Drive the places in ``order`` (depot first and last) from ``start`` and simulate the day.
 
@@ -81,7 +82,7 @@ def simulate_route(
     latest_return_s
         When the van must be back [s after ``start``], if ever.
     charges
-        The charges at the depot between stops, by their position in ``order``.
+        The charges between stops (at the depot or a charger), by position in ``order``.
     """
 
     def laid_out(departure: dt.datetime, windows: Sequence[Windows] | None) -> Timeline:
@@ -181,7 +182,7 @@ class _Split:
         out = []
         payload = self.problem.van.payload_kg
         for k, j in enumerate(self.order[1:-1]):
-            if j == 0:  # back at the depot to charge
+            if not 0 < j <= len(self.problem.stops):  # at a charger
                 continue
             b, c = int(self.timeline.arrive[k]), int(self.timeline.leave[k])
             served = int(self.timeline.serve[k])
@@ -206,18 +207,18 @@ class _Split:
         return out
 
     def charges(self) -> list[ChargeResult]:
-        """The charges at the depot between stops, with what the simulation made of them."""
-        charger = self.problem.depot.charger
-        visits = [k for k, j in enumerate(self.order[1:-1]) if j == 0]
+        """The charges between stops, with what the simulation made of them."""
+        points = charge_points(self.problem)
         out = []
-        for k, spell, done in zip(
-            visits, self.timeline.charging, self.simulated.charges, strict=True
+        for position, spell, done in zip(
+            self.timeline.charged_at, self.timeline.charging, self.simulated.charges, strict=True
         ):
-            b, c = int(self.timeline.arrive[k]), int(self.timeline.leave[k])
+            j = self.order[position]
+            b, c = int(self.timeline.arrive[position - 1]), int(self.timeline.leave[position - 1])
             grid_kwh = (done.charge_grid_j + done.consumers_grid_j) / JOULES_PER_KWH
             out.append(
                 ChargeResult(
-                    charger_id="depot",
+                    charger_id=DEPOT_CHARGER_ID if j == 0 else self.scene.places[j].id,
                     arrive=self.moment(b),
                     depart=self.moment(c),
                     soc_before=done.soc_before,
@@ -225,7 +226,9 @@ class _Split:
                     grid_kwh=grid_kwh,
                     battery_kwh=done.stored_j / JOULES_PER_KWH,
                     minutes=spell.duration_s / 60,
-                    cost=grid_kwh * (charger.price_per_kwh if charger is not None else 0.0),
+                    cost=grid_kwh * points[j].price_per_kwh,
+                    lat=self.scene.places[j].lat,
+                    lon=self.scene.places[j].lon,
                 )
             )
         return out

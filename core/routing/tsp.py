@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import itertools
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -127,6 +127,28 @@ def solve_tour(
     if proven:
         return done(best, "optimal")
     return done(_improve(cost, best, deadline), "feasible")
+
+
+def solve_path(
+    cost: NDArray[np.int64], nodes: list[int], time_limit_s: float = 1.0, keep_order: bool = False
+) -> Tour:
+    """The cheapest path through ``nodes`` of ``cost`` from the first to the last, as node
+    indices from first to last (the same node first and last: a round trip); its cost and
+    status are the path's. A path is solved as a round trip on a matrix where the only way out
+    of the last node leads back to the first at no cost."""
+    first, last = nodes[0], nodes[-1]
+    if first == last:
+        inner = nodes[:-1]
+        tour = solve_tour(cost[np.ix_(inner, inner)], time_limit_s, keep_order)
+        return replace(tour, order=[inner[k] for k in tour.order])
+    path = cost[np.ix_(nodes, nodes)].copy()
+    end = len(nodes) - 1
+    never = int(path.max()) * len(nodes) + 1
+    path[end, :] = never
+    path[:, 0] = never
+    path[end, 0] = 0
+    tour = solve_tour(path, time_limit_s, keep_order)
+    return replace(tour, order=[nodes[k] for k in tour.order[:-1]])
 
 
 def prepare() -> None:

@@ -3,7 +3,12 @@ the chargers and charging curves a client may get wrong."""
 
 import pytest
 
-from app.examples import CHARGING_PLAN_EXAMPLE, FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
+from app.examples import (
+    CHARGING_PLAN_EXAMPLE,
+    EN_ROUTE_CHARGING_EXAMPLE,
+    FLEET_PLAN_EXAMPLE,
+    PLAN_EXAMPLE,
+)
 
 PROBLEM = "application/problem+json"
 
@@ -29,8 +34,12 @@ def test_the_charging_example_comes_back_to_charge_and_holds_its_reserve(client)
         "battery_kwh",
         "minutes",
         "cost",
+        "lat",
+        "lon",
     }
     assert charge["charger_id"] == "depot"
+    depot = CHARGING_PLAN_EXAMPLE["depot"]
+    assert (charge["lat"], charge["lon"]) == (depot["lat"], depot["lon"])
     assert charge["soc_before"] < charge["soc_after"] < 1.0
     assert charge["cost"] == pytest.approx(0.3 * charge["grid_kwh"])
     # every stop served once, the lowest charge at or above the 10 % reserve
@@ -43,7 +52,7 @@ def test_a_fleet_with_a_depot_charger_says_it_does_not_charge(client):
     depot = FLEET_PLAN_EXAMPLE["depot"] | {"charger": {"power_kw": 22}}
     response = client.post("/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE | {"depot": depot})
     assert response.status_code == 200
-    assert any("charger is not used" in w for w in response.json()["warnings"])
+    assert any("chargers are not used" in w for w in response.json()["warnings"])
 
 
 @pytest.mark.parametrize(
@@ -110,3 +119,87 @@ def test_the_map_shows_each_charge_at_the_depot(client):
         f["geometry"]["coordinates"] == [depot["lon"], depot["lat"]] for f in charges
     )
     assert charges[0]["properties"]["soc_after"] > charges[0]["properties"]["soc_before"]
+
+
+def test_the_en_route_example_charges_at_the_fast_charger_on_the_way(client):
+    response = client.post("/v1/plans", json=EN_ROUTE_CHARGING_EXAMPLE)
+    assert response.status_code == 200
+    body = response.json()
+    assert body["battery"]["feasible"] is True and body["battery"]["min_soc"] >= 0.1
+    charges = body["charges"]
+    assert charges and {c["charger_id"] for c in charges} == {"hpc-prater"}
+    assert body["tour"].count("hpc-prater") == len(charges)
+    assert body["tour"].count("depot-centre") == 2 and "ac-slow" not in body["tour"]
+    for charge in charges:
+        assert (charge["lat"], charge["lon"]) == (48.215, 16.40)
+        assert charge["cost"] == pytest.approx(0.59 * charge["grid_kwh"])
+        assert charge["arrive"][11:16] >= "06:00" and charge["depart"][11:16] <= "22:00"
+    geojson = client.post(
+        "/v1/plans", json=EN_ROUTE_CHARGING_EXAMPLE, headers={"Accept": "application/geo+json"}
+    ).json()
+    points = [f for f in geojson["features"] if f["properties"]["kind"] == "charge"]
+    assert points and all(p["geometry"]["coordinates"] == [16.40, 48.215] for p in points)
+
+
+def test_a_fleet_with_chargers_on_the_way_says_it_does_not_charge(client):
+    chargers = EN_ROUTE_CHARGING_EXAMPLE["chargers"]
+    response = client.post("/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE | {"chargers": chargers})
+    assert response.status_code == 200
+    assert any("chargers are not used" in w for w in response.json()["warnings"])
+
+
+CHARGER = {"id": "hpc", "lat": 48.215, "lon": 16.40, "power_kw": 150}
+
+
+@pytest.mark.parametrize(
+    ("charger", "field"),
+    [
+        (CHARGER | {"power_kw": 0}, "chargers[0].power_kw"),
+        (CHARGER | {"power_kw": -50}, "chargers[0].power_kw"),
+        (CHARGER | {"power_kw": "Infinity"}, "chargers[0].power_kw"),
+        (CHARGER | {"points": 0}, "chargers[0].points"),
+        (CHARGER | {"lat": 91}, "chargers[0].lat"),
+        (CHARGER | {"lon": "NaN"}, "chargers[0].lon"),
+        (CHARGER | {"price_per_kwh": -0.1}, "chargers[0].price_per_kwh"),
+        ({k: v for k, v in CHARGER.items() if k != "id"}, "chargers[0].id"),
+        (
+            CHARGER | {"opening_hours": [{"start": "18:00", "end": "06:00"}]},
+            "chargers[0].opening_hours[0].end",
+        ),
+        (
+            CHARGER
+            | {
+                "opening_hours": [
+                    {"start": "06:00", "end": "12:00"},
+                    {"start": "11:00", "end": "20:00"},
+                ]
+            },
+            "chargers[0].opening_hours[1].start",
+        ),
+        (
+            CHARGER | {"opening_hours": [{"start": "25:00", "end": "26:00"}]},
+            "chargers[0].opening_hours[0].start",
+        ),
+        (CHARGER | {"id": "depot"}, "chargers[0].id"),
+        (CHARGER | {"id": PLAN_EXAMPLE["stops"][0]["id"]}, "chargers[0].id"),
+    ],
+)
+def test_bad_chargers_on_the_way_are_422_naming_the_field(client, charger, field):
+    depot = PLAN_EXAMPLE["depot"] | {"id": "hub"}
+    response = client.post("/v1/plans", json=PLAN_EXAMPLE | {"depot": depot, "chargers": [charger]})
+    assert response.status_code == 422
+    assert response.headers["content-type"] == PROBLEM
+    assert any(e["field"] == field for e in response.json()["errors"]), response.json()["errors"]
+
+
+def test_two_chargers_of_one_id_and_a_matrix_beside_chargers_are_422(client):
+    response = client.post("/v1/plans", json=PLAN_EXAMPLE | {"chargers": [CHARGER, CHARGER]})
+    assert response.status_code == 422
+    assert response.json()["errors"][0]["field"] == "chargers[1].id"
+    n = len(PLAN_EXAMPLE["stops"]) + 1
+    matrix = {"distances_m": [[1000.0] * n] * n, "durations_s": [[100.0] * n] * n}
+    response = client.post(
+        "/v1/plans", json=PLAN_EXAMPLE | {"chargers": [CHARGER], "matrix": matrix}
+    )
+    assert response.status_code == 422
+    assert response.json()["errors"][0]["field"] == "chargers"

@@ -152,6 +152,24 @@ def test_a_stop_in_the_sea_is_named(roads):
     assert error["field"] == "stops[2]" and "nearest road" in error["message"]
 
 
+def test_a_charger_in_the_sea_is_named(roads):
+    body = monaco_plan(["moneghetti", "casino", "palais"])
+    at_sea = {"id": "sea-charger", "lat": 43.70, "lon": 7.45, "power_kw": 50}
+    on_land = at_sea | {
+        "id": "casino-charger",
+        "lat": PLACES["casino"][0],
+        "lon": PLACES["casino"][1],
+    }
+    response = roads.post("/v1/plans", json=body | {"chargers": [on_land, at_sea]})
+    assert response.status_code == 422
+    error = response.json()["errors"][0]
+    assert error["field"] == "chargers[1]" and "nearest road" in error["message"]
+    # on a street it is a place the round may charge at, not a stop: the tour leaves it out
+    planned = roads.post("/v1/plans", json=body | {"chargers": [on_land]})
+    assert planned.status_code == 200
+    assert "casino-charger" not in planned.json()["tour"] and planned.json()["charges"] == []
+
+
 def test_a_van_in_the_sea_is_named_as_its_start_state(roads):
     at_sea = {"lat": 43.70, "lon": 7.45, "time": "2026-07-15T12:00:00+02:00", "soc": 0.8}
     body = monaco_plan(["moneghetti", "casino", "palais"], start_state=at_sea)

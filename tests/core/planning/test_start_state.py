@@ -13,7 +13,7 @@ from core.params import RoadMatrix, TimeWindow
 from core.planning.model import StartState
 from core.planning.round import plan
 from core.planning.start_state import START_ID
-from tests.core.planning.test_depot_charging import summer_day
+from tests.core.planning.test_recharge import summer_day
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,413 @@
+"""Charging on the day: a round whose battery would run below its reserve stops between
+stops at a charger — the depot's or one on the way — as often as it needs, and charges what
+the rest needs (partial recharge).
+
+The charges split the round into stretches. Each pass simulates the day in full
+(:func:`core.planning.verify.simulate_route`) and
+
+1. for the first stretch that runs below the reserve, weighs every stop the van leaves with
+   its reserve and every charger it reaches from there with its reserve (the simulated day's
+   driven energy per metre, with :data:`RETURN_ENERGY_FACTOR`, and its standing draw per
+   second price the way) and that is open long enough when it comes, by the time the day
+   gains: the detour, the wait for the opening, the plug-in and the charge along the curve
+   at the charger's power (when one charge cannot cover the rest of the stretch, the rest at
+   another visit like it). The best of :data:`OPTIONS_TRIED` that the simulation confirms —
+   the van gets there with its reserve and the day's lowest point is higher — is made; the
+   new charge first fills the battery;
+2. fits every charge to what the simulation says the next stretch takes: up to the reserve
+   plus that stretch's drop plus :data:`PARTIAL_CHARGE_MARGIN` (or to full with
+   ``battery.charge_to_full``), the minutes from the charging curve
+   (:mod:`core.physics.charging`) at the state of charge the van arrives with (after any
+   wait for the opening).
+
+The consumption of a stretch does not depend on how full the battery is, so the fitted
+charges hold when simulated again. When the order is the planner's, the round is then solved
+again through the chargers it visits and each stretch put in its own best order; the best
+that holds on the objective is kept. The verdict is always the final simulation's.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import Protocol
+
+from core.params import ChargePoint, Charger
+from core.physics.battery import JOULES_PER_KWH
+from core.physics.charging import WATTS_PER_KW, ChargeCurve, charge_curve
+from core.planning.model import PlanProblem, PlanResult, RoundFields, Solved
+from core.planning.scene import Scene, charge_points
+from core.planning.timeline import ChargeVisit, Windows, next_window, seconds_after
+from core.planning.verify import simulate_route
+from core.routing.roads import LegRoute
+
+#: State of charge charged beyond what the next stretch needs and its reserve [–]: the
+#: stretch is simulated again after the charge and may start a little later, in other weather.
+PARTIAL_CHARGE_MARGIN = 0.03
+#: The way to a charger takes this much more energy per metre than the day's mean drive (it
+#: is not simulated before it is chosen; the simulation then checks it).
+RETURN_ENERGY_FACTOR = 1.25
+#: Most places to charge simulated for one charge, best estimate first: a charger the
+#: estimate wrongly thought within reach is skipped for the next.
+OPTIONS_TRIED = 3
+
+Roads = Callable[[list[int]], list[LegRoute] | None]
+
+
+class Orders(Protocol):
+    """Better orders of a round that charges."""
+
+    def stretch(self, places: list[int]) -> list[int]:
+        """A stretch's places in a better order, its first and last kept."""
+        ...
+
+    def through(self, chargers: list[int]) -> list[int]:
+        """The whole round in its best order with a visit to each of ``chargers`` (place
+        indices; one listed twice is visited twice)."""
+        ...
+
+
+def with_charges(
+    problem: PlanProblem,
+    scene: Scene,
+    order: list[int],
+    start: dt.datetime,
+    roads: Roads,
+    solved: Solved,
+    windows_s: Sequence[Windows] | None = None,
+    orders: Orders | None = None,
+) -> PlanResult:
+    """The round in ``order`` simulated, with charges between stops where the battery would
+    not last (none when it does, or without chargers). With ``orders``, the round is then
+    solved again through the chargers it visits, and each stretch between charges put in its
+    own best order: the best of these that holds is kept (:func:`_better_orders`)."""
+    day = _Round(problem, scene, start, roads, solved, windows_s)
+    result = day.simulate(order)
+    points = charge_points(problem)
+    if not points or result.battery.feasible:
+        return result
+    charged = _charged_until_it_holds(day, points, _Charged(order, {}, result))
+    result = charged.result
+    if orders is not None and charged.charges and result.battery.feasible:
+        result = _better_orders(day, points, charged, orders)
+    if not result.battery.feasible:
+        leg = result.first_infeasible_leg
+        where = f" on the way to '{result.legs[leg].to_id}'" if leg is not None else ""
+        warning = (
+            f"even with charging the battery runs below its reserve{where}: no stop before it "
+            "lets the van reach an open charger with its reserve (no charger within reach)"
+        )
+        result = replace(result, warnings=[*result.warnings, warning])
+    return result
+
+
+def _charged(
+    day: _Round,
+    points: dict[int, ChargePoint],
+    order: list[int],
+    charges: dict[int, ChargeVisit],
+    result: PlanResult,
+    stretch: tuple[int, int],
+) -> tuple[list[int], dict[int, ChargeVisit], PlanResult] | None:
+    """The day with one more charge in ``stretch``: the best of the options
+    (:func:`_charge_options`, at most :data:`OPTIONS_TRIED` simulated) that the simulation
+    says the van reaches with its reserve and that leaves the day's lowest point higher;
+    None when none does."""
+    reserve = day.problem.van.battery.min_soc
+    for option in _charge_options(day, points, order, charges, result, stretch)[:OPTIONS_TRIED]:
+        cut = option.cut
+        tried = [*order[: cut + 1], option.place, *order[cut + 1 :]]
+        visits = {q + (q > cut): c for q, c in charges.items()} | {cut + 1: option.visit}
+        simulated = day.simulate(tried, visits)  # filled, then every charge fitted
+        tried, visits = _without_idle(tried, _fitted(day.problem, tried, simulated, visits))
+        simulated = day.simulate(tried, visits)
+        reached = simulated.legs[cut].soc_end >= reserve
+        if reached and simulated.battery.margin_kwh > result.battery.margin_kwh:
+            return tried, visits, simulated
+    return None
+
+
+@dataclass(frozen=True)
+class _Charged:
+    """A round's order, its charges by position and its simulation."""
+
+    order: list[int]
+    charges: dict[int, ChargeVisit]
+    result: PlanResult
+
+
+def _charged_until_it_holds(
+    day: _Round, points: dict[int, ChargePoint], charged: _Charged
+) -> _Charged:
+    """``charged`` with one more charge in its first stretch below the reserve, again and
+    again, until the battery holds or no charger is within reach."""
+    for _ in range(len(charged.order)):
+        order, charges, result = charged.order, charged.charges, charged.result
+        stretch = _first_short_stretch(day.problem, order, charges, result)
+        if stretch is None:
+            break
+        tried = _charged(day, points, order, charges, result, stretch)
+        if tried is None:
+            break  # no charger within reach
+        charged = _Charged(*tried)
+    return charged
+
+
+@dataclass(frozen=True)
+class _Round:
+    """What every simulation of the round shares; :meth:`simulate` drives one order."""
+
+    problem: PlanProblem
+    scene: Scene
+    start: dt.datetime
+    roads: Roads
+    solved: Solved
+    windows_s: Sequence[Windows] | None
+
+    def simulate(
+        self, order: list[int], charges: dict[int, ChargeVisit] | None = None
+    ) -> PlanResult:
+        return simulate_route(
+            self.problem,
+            self.scene,
+            order,
+            self.start,
+            self.roads(order),
+            self.solved,
+            self.windows_s,
+            charges=charges,
+        )
+
+    def curve(self, point: ChargePoint, result: PlanResult) -> ChargeCurve:
+        """The van's charging curve at ``point`` (on the battery's usable capacity as aged)."""
+        battery = self.problem.van.battery
+        share = result.battery.usable_capacity_kwh / battery.usable_capacity_kwh
+        return charge_curve(battery, point.power_kw * WATTS_PER_KW, share)
+
+    def open_s(self, point: ChargePoint) -> Windows:
+        """When ``point`` is open [s after the departure]; empty: always."""
+        if not isinstance(point, Charger):
+            return ()
+        date, start = self.problem.date, self.start
+        return [
+            (seconds_after(date, w.start, start), seconds_after(date, w.end, start))
+            for w in point.opening_hours
+        ]
+
+
+def _better_orders(
+    day: _Round, points: dict[int, ChargePoint], charged: _Charged, orders: Orders
+) -> PlanResult:
+    """The best on the objective of the charged round and of others, each with its charges
+    fitted again and kept only when its battery holds: the whole round solved again through
+    the chargers it visits (the solver then passes them where it costs least; charged more
+    where it still runs short), and every stretch between charges in its own best order (of
+    either)."""
+    order, charges = charged.order, charged.charges
+    chargers = [order[q] for q in sorted(charges)]
+    through = orders.through(chargers)
+    visits = {
+        place: [charges[q] for q in sorted(charges) if order[q] == place] for place in chargers
+    }
+    again: dict[int, ChargeVisit] = {}
+    for q in range(1, len(through) - 1):
+        if visits.get(through[q]):
+            again[q] = visits[through[q]].pop(0)
+    retoured = _charged_until_it_holds(day, points, _refitted(day, through, again))
+    best = charged.result
+    for candidate in (charged, retoured):
+        ends = _stretch_ends(candidate.order, candidate.charges)
+        stretches = [
+            orders.stretch(candidate.order[a : b + 1]) for a, b in itertools.pairwise(ends)
+        ]
+        reordered = [candidate.order[0], *(place for stretch in stretches for place in stretch[1:])]
+        tried = [candidate]
+        if reordered != candidate.order:
+            tried.append(_refitted(day, reordered, candidate.charges))
+        for option in tried:
+            result = option.result
+            if result.battery.feasible and _measure(result) < _measure(best):
+                best = result
+    return best
+
+
+def _refitted(day: _Round, order: list[int], charges: dict[int, ChargeVisit]) -> _Charged:
+    """The day in ``order`` with ``charges`` (by position) fitted to what it takes."""
+    first = day.simulate(order, charges)
+    order, fitted = _without_idle(order, _fitted(day.problem, order, first, charges))
+    return _Charged(order, fitted, day.simulate(order, fitted))
+
+
+def _measure(result: PlanResult) -> float:
+    """The round on its objective, as simulated: metres, seconds or kWh."""
+    if result.objective == "duration":
+        return result.duration_s
+    if result.objective == "energy":
+        return result.energy_kwh["total"]
+    return result.distance_m
+
+
+def charging_not_planned(problem: RoundFields) -> list[str]:
+    """The warning of a plan that does not charge although it could (a fleet, or a round with
+    time windows: their searches do not plan charges yet)."""
+    if problem.depot.charger is None and not problem.chargers:
+        return []
+    return [
+        "the chargers are not used: charges are planned for rounds without time windows "
+        "(POST /v1/plans); this plan's battery verdict is without charging"
+    ]
+
+
+def _stretch_ends(order: list[int], charges: dict[int, ChargeVisit]) -> list[int]:
+    """Where the stretches of ``order`` begin and end: its start (the depot, or the van's
+    position when it starts under way), each charge, its end."""
+    return [0, *sorted(charges), len(order) - 1]
+
+
+def _stretch_low(result: PlanResult, first: int, last: int) -> float:
+    """The lowest state of charge over legs ``first`` to ``last − 1`` (a stretch) [–]."""
+    legs = result.legs[first:last]
+    return min(min(leg.soc_start, leg.soc_end) for leg in legs)
+
+
+def _first_short_stretch(
+    problem: PlanProblem, order: list[int], charges: dict[int, ChargeVisit], result: PlanResult
+) -> tuple[int, int] | None:
+    """The first stretch (from one charge, or the start, to the next) below the reserve."""
+    reserve = problem.van.battery.min_soc
+    for first, last in itertools.pairwise(_stretch_ends(order, charges)):
+        if _stretch_low(result, first, last) < reserve - 1e-9:
+            return first, last
+    return None
+
+
+@dataclass(frozen=True)
+class _Option:
+    """Charging at place ``place`` after position ``cut`` of the order: the time it adds [s]
+    and the visit (a full charge, fitted after)."""
+
+    cut: int
+    place: int
+    added_s: float
+    visit: ChargeVisit
+
+
+def _charge_options(
+    day: _Round,
+    points: dict[int, ChargePoint],
+    order: list[int],
+    charges: dict[int, ChargeVisit],
+    result: PlanResult,
+    stretch: tuple[int, int],
+) -> list[_Option]:
+    """Where the van may charge within ``stretch``, best first: after each stop it leaves
+    with its reserve, each charger it reaches with its reserve and that is open long enough
+    for the charge, by the time the day gains (the detour, the wait for the opening, the
+    plug-in and the charge along the curve at the charger's power; when one charge does not
+    cover the rest of the stretch, the rest at another visit like it)."""
+    reserve = day.problem.van.battery.min_soc
+    legs = day.scene.legs
+    capacity_j = result.battery.usable_capacity_kwh * JOULES_PER_KWH
+    driven_j = sum(leg.energy_kwh["traction"] for leg in result.legs) * JOULES_PER_KWH
+    per_metre_j = max(driven_j, 0.0) / max(result.distance_m, 1.0) * RETURN_ENERGY_FACTOR
+    standing_j = result.energy_kwh["total"] * JOULES_PER_KWH - driven_j
+    per_second_j = max(standing_j, 0.0) / max(result.duration_s, 1.0)
+
+    def way_soc(a: int, b: int) -> float:
+        """The state of charge the drive from place ``a`` to ``b`` takes, estimated [–]."""
+        way_j = per_metre_j * legs.distance_m[a, b] + per_second_j * legs.duration_s[a, b]
+        return float(way_j / capacity_j)
+
+    options: list[_Option] = []
+    for p in range(stretch[0], stretch[1]):
+        here, onward = order[p], order[p + 1]
+        if p in charges or (p == 0 and here == 0):  # charged here already, or the depot
+            continue
+        leaving = result.legs[p].soc_start
+        left_s = (result.legs[p].depart - day.start).total_seconds()
+        rest = _energy_j(result, p + 1, stretch[1]) / capacity_j
+        for place, point in points.items():
+            if place in (here, onward):
+                continue
+            come_s = left_s + legs.duration_s[here, place]
+            hours = next_window(come_s, day.open_s(point))
+            if hours is None:
+                continue
+            wait_s = max(hours[0] - come_s, 0.0)
+            plugged = leaving - way_soc(here, place) - per_second_j * wait_s / capacity_j
+            if leaving < reserve or plugged < reserve + PARTIAL_CHARGE_MARGIN / 2:
+                continue
+            plug_s = point.plug_minutes * 60
+            detour_s = float(
+                legs.duration_s[here, place]
+                + legs.duration_s[place, onward]
+                - legs.duration_s[here, onward]
+            )
+            needed = reserve + rest + way_soc(place, onward) + PARTIAL_CHARGE_MARGIN
+            curve = day.curve(point, result)
+            charge_s = curve.time_s(plugged, min(needed, 1.0))
+            if come_s + wait_s + plug_s + charge_s > hours[1]:
+                continue  # it closes before the charge is done
+            if needed > 1.0:  # the rest at another visit like this one
+                rate_w = float(curve.power_at_w(reserve)[()]) * curve.efficiency
+                charge_s += (needed - 1.0) * capacity_j / rate_w + detour_s + plug_s
+            visit = ChargeVisit(
+                plug_s, curve.time_s(plugged, 1.0), point.power_kw, day.open_s(point)
+            )
+            options.append(_Option(p, place, detour_s + wait_s + plug_s + charge_s, visit))
+    return sorted(options, key=lambda o: (o.added_s, -o.cut))
+
+
+def _energy_j(result: PlanResult, first: int, end: int) -> float:
+    """What the round takes from the arrival at position ``first`` of the order to position
+    ``end`` (no charge between): its legs and its stops, as simulated [J] (energy, not the
+    state of charge, which stops falling at empty)."""
+    stops = {stop.id: stop for stop in result.stops}
+    legs = result.legs[first:end]
+    places = [leg.from_id for leg in legs]
+    standing = sum(stops[i].energy_kwh["total"] for i in places if i in stops)
+    driving = sum(leg.energy_kwh["total"] for leg in legs)
+    return (standing + driving) * JOULES_PER_KWH
+
+
+def _fitted(
+    problem: PlanProblem, order: list[int], result: PlanResult, charges: dict[int, ChargeVisit]
+) -> dict[int, ChargeVisit]:
+    """Every charge fitted to the stretch after it, from what ``result`` simulated: the state
+    of charge each stretch drops by does not depend on where it starts."""
+    battery = problem.van.battery
+    share = result.battery.usable_capacity_kwh / battery.usable_capacity_kwh
+    ends = _stretch_ends(order, charges)
+    plugged = {charge.arrive: charge.soc_before for charge in result.charges}
+    fitted: dict[int, ChargeVisit] = {}
+    leaving = result.legs[0].soc_start
+    for k in range(1, len(ends) - 1):
+        came, here, goes = ends[k - 1], ends[k], ends[k + 1]
+        came_in = result.legs[here - 1]
+        # what the stretch and the wait for the opening took, as simulated
+        waited = came_in.soc_end - plugged.get(came_in.arrive, came_in.soc_end)
+        arriving = leaving - (result.legs[came].soc_start - came_in.soc_end) - waited
+        drop = result.legs[here].soc_start - _stretch_low(result, here, goes)
+        target = (
+            1.0
+            if battery.charge_to_full
+            else min(battery.min_soc + drop + PARTIAL_CHARGE_MARGIN, 1.0)
+        )
+        visit = charges[here]
+        curve = charge_curve(battery, visit.power_kw * WATTS_PER_KW, share)
+        fitted[here] = replace(visit, charge_s=curve.time_s(arriving, target))
+        leaving = max(arriving, target)
+    return fitted
+
+
+def _without_idle(
+    order: list[int], charges: dict[int, ChargeVisit]
+) -> tuple[list[int], dict[int, ChargeVisit]]:
+    """``order`` and ``charges`` without the charger visits that have nothing to charge (an
+    earlier charge covers their stretch too)."""
+    idle = {q for q, visit in charges.items() if visit.charge_s <= 0}
+    kept = [place for q, place in enumerate(order) if q not in idle]
+    moved = {q - sum(i < q for i in idle): visit for q, visit in charges.items() if q not in idle}
+    return kept, moved
