@@ -19,8 +19,9 @@ from core.exceptions import NoRouteError
 from core.params import Place
 from core.planning.estimates import VanEstimates, van_estimates
 from core.planning.model import MAX_ROUND_S, PlanProblem, PlanResult, Solved, place_field
+from core.planning.recharge import Busy, with_charges
 from core.planning.scene import Scene
-from core.planning.timeline import windows_after
+from core.planning.timeline import ChargeVisit, windows_after
 from core.planning.verify import simulate_route
 from core.routing.geo import Legs
 from core.routing.roads import LegRoute, RoadRouter
@@ -97,8 +98,8 @@ class FleetDay:
 
     @property
     def n(self) -> int:
-        """Places, the depot included."""
-        return len(self.scene.places)
+        """The solver's places: the depot and the stops (the chargers come after them)."""
+        return len(self.finite)
 
     @property
     def vans(self) -> range:
@@ -114,25 +115,56 @@ class FleetDay:
         """The full simulation of van ``v`` driving ``route`` (stops; the depot around it):
         windows from its own departure, the router's roads when the legs came from it, back by
         its shift's end."""
+        problem, scene, order, start, solved = self._round(v, route)
+        windows, latest_s = self._limits(v)
+        return simulate_route(
+            problem, scene, order, start, self._roads(order), solved, windows, latest_s
+        )
+
+    def charged(
+        self, v: int, order: list[int], charges: dict[int, ChargeVisit], busy: Busy
+    ) -> PlanResult:
+        """Van ``v`` driving ``order`` (place indices, the chargers it visits among them) with
+        ``charges`` fitted again and more where its battery would not last
+        (:func:`core.planning.recharge.with_charges`): its windows and its shift kept, the
+        charge points free when ``busy`` says other vans do not take them all."""
+        stops = [place for place in order[1:-1] if 0 < place < self.n]
+        problem, scene, _, start, solved = self._round(v, stops)
+        windows, latest_s = self._limits(v)
+        return with_charges(
+            problem,
+            scene,
+            order,
+            start,
+            self._roads,
+            solved,
+            windows,
+            None,
+            latest_s,
+            busy,
+            charges,
+        )
+
+    def _round(
+        self, v: int, route: list[int]
+    ) -> tuple[PlanProblem, Scene, list[int], dt.datetime, Solved]:
         shift = self.shifts[v]
-        order = [0, *route, 0]
+        solved = Solved("feasible", self.estimates[v].route_cost(route), 0.0)
+        return shift.problem, self.scene, [0, *route, 0], shift.start, solved
+
+    def _roads(self, order: list[int]) -> list[LegRoute] | None:
+        if self.router is None or self.scene.legs.source != "osrm":
+            return None
+        return leg_roads(self.router, self.scene.places, order)
+
+    def _limits(self, v: int) -> tuple[list[list[tuple[float, float]]], float | None]:
+        """Van ``v``'s windows of every place [s after its departure] and its latest return."""
+        shift = self.shifts[v]
         origin = self.reference.timestamp() - shift.start.timestamp()
         windows = [[(a + origin, b + origin) for a, b in place] for place in self.windows_s]
-        roads = (
-            leg_roads(self.router, self.scene.places, order)
-            if self.router is not None and self.scene.legs.source == "osrm"
-            else None
-        )
-        return simulate_route(
-            shift.problem,
-            self.scene,
-            order,
-            shift.start,
-            roads,
-            Solved("feasible", self.estimates[v].route_cost(route), 0.0),
-            windows,
-            None if shift.end is None else shift.end.timestamp() - shift.start.timestamp(),
-        )
+        windows += [[] for _ in range(len(self.scene.places) - len(windows))]  # the chargers
+        latest_s = None if shift.end is None else shift.end.timestamp() - shift.start.timestamp()
+        return windows, latest_s
 
 
 def fleet_day(shifts: list[VanShift], scene: Scene, router: RoadRouter | None) -> FleetDay:
@@ -147,7 +179,7 @@ def fleet_day(shifts: list[VanShift], scene: Scene, router: RoadRouter | None) -
         )
         for shift in shifts
     ]
-    legs = scene.legs
+    legs = scene.legs.first(len(base.stops) + 1)  # the solver's places: not the chargers
     finite = np.isfinite(legs.duration_s) & np.isfinite(legs.distance_m)
     service_s = np.array([0.0] + [math.ceil(s.service_time_s) for s in base.stops])
     solver_legs = _long_where_no_road(legs, finite)

@@ -18,6 +18,9 @@ the full simulation of its day.
    simulation holds (:mod:`core.planning.repair`). A stop no van can serve is listed with its
    reason (:mod:`core.planning.explain`) — never a route reported feasible that the simulation
    says is not.
+4. With chargers (the depot's, or on the way), the stops left out for their battery are then
+   served by vans that charge where they can (:mod:`core.planning.fleet_charging`), in the
+   share :data:`CHARGING_SHARE` of the budget kept for it.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from core.planning.day import FleetDay, VanShift, fleet_day, leg_roads
 from core.planning.estimates import LearnedTimes
 from core.planning.explain import explain
 from core.planning.feasibility import Feasibility
+from core.planning.fleet_charging import serve_with_charging
 from core.planning.model import (
     FleetProblem,
     FleetResult,
@@ -43,10 +47,9 @@ from core.planning.model import (
     PlanResult,
     RoundFields,
     Unassigned,
-    check_stop_ids,
+    check_places,
     fields_of,
 )
-from core.planning.recharge import charging_not_planned
 from core.planning.repair import Repaired, fitting, repair
 from core.planning.scene import Scene, legs_for
 from core.planning.solver_input import routing_input
@@ -63,6 +66,9 @@ MIN_SOLVE_S = 0.05
 #: A tightened energy budget is cut this much below the simulated need, so the next
 #: solution does not land on the edge again.
 TIGHTEN_MARGIN = 0.98
+#: Share of the budget kept for serving the stops the search left out with charging, when the
+#: fleet has chargers.
+CHARGING_SHARE = 0.4
 #: Stops whose arcs are driven before the first solve to learn the simulation's driving times.
 CALIBRATION_STOPS = 12
 
@@ -86,7 +92,8 @@ def plan_fleet(
     """
     started = time.perf_counter()
     shifts, timezone_name = check_fleet(problem)
-    legs = legs_for(problem, router)
+    places = [*problem.places, *problem.chargers]
+    legs = legs_for(problem, router, places)
     first = min(shift.start for shift in shifts)
     last = max(shift.end for shift in shifts if shift.end is not None)
     # One forecast for the whole day, shared by every van.
@@ -101,17 +108,20 @@ def plan_fleet(
     fastest = max(v.van.vehicle.max_acceleration_mps2 for v in problem.vehicles)
     too_fast = client_legs_too_fast(legs, fastest)
     scene = Scene(
-        problem.places,
+        places,
         legs,
         timezone_name,
         lambda _begin, _span_s: day_weather,
         (too_fast,) if too_fast else (),
     )
     remembering = None if router is None else RememberingRouter(router)
+    deadline = started + problem.time_limit_s
+    charging = problem.depot.charger is not None or bool(problem.chargers)
     routed = search(
         fleet_day(shifts, scene, remembering),
         problem.minimize_vehicles,
-        started + problem.time_limit_s,
+        deadline - problem.time_limit_s * CHARGING_SHARE if charging else deadline,
+        deadline if charging else None,
     )
     routes = routed.stamped(time.perf_counter() - started)
     plans = [route.plan for route in routes]
@@ -129,7 +139,7 @@ def plan_fleet(
         verification_rounds=routed.verification_rounds,
         timezone=timezone_name,
         distance_source=legs.source,
-        warnings=[*day_weather[1], *charging_not_planned(problem)],
+        warnings=day_weather[1],
     )
 
 
@@ -138,7 +148,7 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
     stops and vans, each shift's start and end on the day in the zone, the client's matrix.
     Raises :class:`core.exceptions.CoreError` naming the field; returns each van's shift and
     the zone's name."""
-    check_stop_ids(problem.depot, problem.stops)
+    check_places(problem)
     vans: dict[str, int] = {}
     for index, vehicle in enumerate(problem.vehicles):
         if vehicle.id in vans:
@@ -250,9 +260,13 @@ def _repair(day: FleetDay, v: int, route: list[int], failure: Failure) -> Repair
     return repair(route, failure, simulate, check, day.estimates[v])
 
 
-def search(day: FleetDay, minimize_vehicles: bool, deadline: float) -> Routed:
+def search(
+    day: FleetDay, minimize_vehicles: bool, deadline: float, charging_until: float | None = None
+) -> Routed:
     """Solve and verify until every route holds or ``deadline`` (a ``time.perf_counter``
-    value); ``minimize_vehicles``: fewer vans first, then the objective."""
+    value); ``minimize_vehicles``: fewer vans first, then the objective. With
+    ``charging_until``, the stops then left out for their battery are served by vans that
+    charge, until that moment (:mod:`core.planning.fleet_charging`)."""
     times = LearnedTimes(day.duration_s, day.finite, day.horizon_s)
     calibrate(day, times)
     budgets = [
@@ -299,15 +313,20 @@ def search(day: FleetDay, minimize_vehicles: bool, deadline: float) -> Routed:
             results[v] = repaired.result
     rules = Feasibility(day, times.matrix(), budgets)
     served = {node for route in routes for node in route}
+    unassigned = [
+        explain(rules, node, left_out.get(node), routes)
+        for node in range(1, day.n)
+        if node not in served
+    ]
+    if charging_until is not None:
+        routes, results, unassigned = serve_with_charging(
+            day, routes, results, unassigned, minimize_vehicles, charging_until
+        )
     return Routed(
         routes=[
             FleetRoute(day.shifts[v].id, results[v]) for v in day.vans if routes[v] and v in results
         ],
-        unassigned=[
-            explain(rules, node, left_out.get(node), routes)
-            for node in range(1, day.n)
-            if node not in served
-        ],
+        unassigned=unassigned,
         verification_rounds=rounds,
         objective_value=sum(day.estimates[v].route_cost(r) for v, r in enumerate(routes) if r),
     )

@@ -13,7 +13,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Discriminator, Field, Tag, ValidationInfo, field_validator
 
-from core.exceptions import InvalidStopsError
+from core.exceptions import InvalidParameterError, InvalidStopsError
 from core.params import (
     BRANCH_TAG,
     MAX_CHARGERS,
@@ -295,6 +295,18 @@ def check_stop_ids(depot: Depot, stops: Sequence[Stop], chargers: Sequence[Charg
                     f"{name}[{index}].id",
                 )
             seen[place.id] = f"{name}[{index}]"
+
+
+def check_places(problem: RoundFields) -> None:
+    """Ids of the stops and the chargers their own (:func:`check_stop_ids`), and chargers
+    only with the planner's legs (a client's matrix has no rows for them)."""
+    check_stop_ids(problem.depot, problem.stops, problem.chargers)
+    if problem.chargers and problem.matrix is not None:
+        raise InvalidParameterError(
+            "a client matrix has no rows for the chargers on the way: leave out matrix (the "
+            "planner estimates the legs or asks its router) or chargers",
+            "chargers",
+        )
 
 
 def place_field(index: int) -> str:

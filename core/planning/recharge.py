@@ -30,11 +30,12 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
-from core.params import ChargePoint, Charger
+from core.params import ChargePoint, Charger, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, ChargeCurve, charge_curve
 from core.planning.model import PlanProblem, PlanResult, RoundFields, Solved
@@ -54,6 +55,8 @@ RETURN_ENERGY_FACTOR = 1.25
 OPTIONS_TRIED = 3
 
 Roads = Callable[[list[int]], list[LegRoute] | None]
+#: When every point of a charger is taken by other vans, by the charger's place index.
+Busy = Mapping[int, Sequence[tuple[dt.datetime, dt.datetime]]]
 
 
 class Orders(Protocol):
@@ -78,17 +81,33 @@ def with_charges(
     solved: Solved,
     windows_s: Sequence[Windows] | None = None,
     orders: Orders | None = None,
+    latest_return_s: float | None = None,
+    busy: Busy | None = None,
+    charges: Mapping[int, ChargeVisit] | None = None,
 ) -> PlanResult:
     """The round in ``order`` simulated, with charges between stops where the battery would
     not last (none when it does, or without chargers). With ``orders``, the round is then
     solved again through the chargers it visits, and each stretch between charges put in its
-    own best order: the best of these that holds is kept (:func:`_better_orders`)."""
-    day = _Round(problem, scene, start, roads, solved, windows_s)
-    result = day.simulate(order)
+    own best order: the best of these that holds is kept (:func:`_better_orders`).
+
+    With ``windows_s`` (each place's time windows [s after ``start``]) and
+    ``latest_return_s`` (when the van must be back), a charge is only made where the time it
+    adds leaves every later window and the return in time (the forward time slack); ``busy``
+    says when other vans take every point of a charger: the van charges between. ``charges``
+    (by position in ``order``) are visits to start from, fitted again: a plan that changed a
+    little keeps its charges where they still serve (:func:`visits_of`)."""
+    day = _Round(problem, scene, start, roads, solved, windows_s, latest_return_s, busy or {})
     points = charge_points(problem)
-    if not points or result.battery.feasible:
-        return result
-    charged = _charged_until_it_holds(day, points, _Charged(order, {}, result))
+    if charges:  # the visits of an earlier plan, fitted again (open when free now)
+        first = {
+            q: replace(c, open_s=day.open_s(order[q], points[order[q]])) for q, c in charges.items()
+        }
+        charged = _refitted(day, order, first)
+    else:
+        charged = _Charged(order, {}, day.simulate(order))
+    if not points or charged.result.battery.feasible:
+        return charged.result
+    charged = _charged_until_it_holds(day, points, charged)
     result = charged.result
     if orders is not None and charged.charges and result.battery.feasible:
         result = _better_orders(day, points, charged, orders)
@@ -165,6 +184,8 @@ class _Round:
     roads: Roads
     solved: Solved
     windows_s: Sequence[Windows] | None
+    latest_return_s: float | None = None
+    busy: Busy = field(default_factory=dict)
 
     def simulate(
         self, order: list[int], charges: dict[int, ChargeVisit] | None = None
@@ -177,7 +198,8 @@ class _Round:
             self.roads(order),
             self.solved,
             self.windows_s,
-            charges=charges,
+            self.latest_return_s,
+            charges,
         )
 
     def curve(self, point: ChargePoint, result: PlanResult) -> ChargeCurve:
@@ -186,15 +208,58 @@ class _Round:
         share = result.battery.usable_capacity_kwh / battery.usable_capacity_kwh
         return charge_curve(battery, point.power_kw * WATTS_PER_KW, share)
 
-    def open_s(self, point: ChargePoint) -> Windows:
-        """When ``point`` is open [s after the departure]; empty: always."""
-        if not isinstance(point, Charger):
-            return ()
+    def open_s(self, place: int, point: ChargePoint) -> Windows:
+        """When ``point`` (at ``place``) is open and has a point free [s after the
+        departure]; empty: always."""
         date, start = self.problem.date, self.start
-        return [
+        hours = [
             (seconds_after(date, w.start, start), seconds_after(date, w.end, start))
-            for w in point.opening_hours
+            for w in (point.opening_hours if isinstance(point, Charger) else ())
         ]
+        taken = [
+            ((a - start).total_seconds(), (b - start).total_seconds())
+            for a, b in self.busy.get(place, ())
+        ]
+        if not taken:
+            return hours
+        free = _without(hours or [(-math.inf, math.inf)], sorted(taken))
+        return free or [(-math.inf, -math.inf)]  # taken all day: never free
+
+
+def _without(windows: Windows, taken: Windows) -> list[tuple[float, float]]:
+    """``windows`` less the sorted spans ``taken``."""
+    free: list[tuple[float, float]] = []
+    for opens, closes in windows:
+        at = opens
+        for a, b in taken:
+            if b <= at or a >= closes:
+                continue
+            if a > at:
+                free.append((at, a))
+            at = max(at, b)
+        if at < closes:
+            free.append((at, closes))
+    return free
+
+
+def visits_of(
+    problem: PlanProblem, places: list[Place], result: PlanResult
+) -> tuple[list[int], dict[int, ChargeVisit]]:
+    """The order (place indices) a plan drove and its charges by position, as visits to start
+    a changed plan from."""
+    index = {place.id: k for k, place in enumerate(places)}
+    order = [0, *(index[i] for i in result.tour[1:-1]), 0]
+    if result.tour[0] != places[0].id:  # under way: from the van's position
+        order[0] = index[result.tour[0]]
+    points = charge_points(problem)
+    by_arrival = {charge.arrive: charge for charge in result.charges}
+    visits = {}
+    for q in range(1, len(order) - 1):
+        charge = by_arrival.get(result.legs[q - 1].arrive)
+        if order[q] in points and charge is not None:
+            point = points[order[q]]
+            visits[q] = ChargeVisit(point.plug_minutes * 60, charge.minutes * 60, point.power_kw)
+    return order, visits
 
 
 def _better_orders(
@@ -250,13 +315,13 @@ def _measure(result: PlanResult) -> float:
 
 
 def charging_not_planned(problem: RoundFields) -> list[str]:
-    """The warning of a plan that does not charge although it could (a fleet, or a round with
-    time windows: their searches do not plan charges yet)."""
+    """The warning of a round with time windows that does not charge although it could (its
+    search, the fleet's with one van, does not plan charges: the battery is only reported)."""
     if problem.depot.charger is None and not problem.chargers:
         return []
     return [
-        "the chargers are not used: charges are planned for rounds without time windows "
-        "(POST /v1/plans); this plan's battery verdict is without charging"
+        "the chargers are not used: charges are planned for rounds without time windows and "
+        "for fleets (POST /v1/fleet-plans); this plan's battery verdict is without charging"
     ]
 
 
@@ -320,6 +385,7 @@ def _charge_options(
         way_j = per_metre_j * legs.distance_m[a, b] + per_second_j * legs.duration_s[a, b]
         return float(way_j / capacity_j)
 
+    slack = _slack_s(day, order, result)
     options: list[_Option] = []
     for p in range(stretch[0], stretch[1]):
         here, onward = order[p], order[p + 1]
@@ -332,7 +398,8 @@ def _charge_options(
             if place in (here, onward):
                 continue
             come_s = left_s + legs.duration_s[here, place]
-            hours = next_window(come_s, day.open_s(point))
+            open_s = day.open_s(place, point)
+            hours = next_window(come_s, open_s)
             if hours is None:
                 continue
             wait_s = max(hours[0] - come_s, 0.0)
@@ -350,14 +417,41 @@ def _charge_options(
             charge_s = curve.time_s(plugged, min(needed, 1.0))
             if come_s + wait_s + plug_s + charge_s > hours[1]:
                 continue  # it closes before the charge is done
+            added_s = detour_s + wait_s + plug_s + charge_s
+            if added_s > slack[p + 1]:
+                continue  # a later window or the return would be missed
             if needed > 1.0:  # the rest at another visit like this one
                 rate_w = float(curve.power_at_w(reserve)[()]) * curve.efficiency
-                charge_s += (needed - 1.0) * capacity_j / rate_w + detour_s + plug_s
-            visit = ChargeVisit(
-                plug_s, curve.time_s(plugged, 1.0), point.power_kw, day.open_s(point)
-            )
-            options.append(_Option(p, place, detour_s + wait_s + plug_s + charge_s, visit))
+                added_s += (needed - 1.0) * capacity_j / rate_w + detour_s + plug_s
+            visit = ChargeVisit(plug_s, curve.time_s(plugged, 1.0), point.power_kw, open_s)
+            options.append(_Option(p, place, added_s, visit))
     return sorted(options, key=lambda o: (o.added_s, -o.cut))
+
+
+def _slack_s(day: _Round, order: list[int], result: PlanResult) -> list[float]:
+    """How much later the van may reach each position of ``order`` and still serve every
+    later stop inside its window and be back in time [s] (Savelsbergh's forward time slack,
+    *ORSA J. Computing* 4 (1992) 146: a delay is absorbed by the waits, then shifts each
+    service up to its window's close); infinite without windows and a latest return."""
+    if day.windows_s is None and day.latest_return_s is None:
+        return [math.inf] * len(order)
+    start = day.start
+    back_s = (result.legs[-1].arrive - start).total_seconds()
+    slack = [math.inf] * len(order)
+    if day.latest_return_s is not None:
+        slack[-1] = day.latest_return_s - back_s
+    stops = {stop.id: stop for stop in result.stops}
+    for q in range(len(order) - 2, 0, -1):
+        stop = stops.get(day.scene.places[order[q]].id)
+        if stop is None:  # a charger: a delay goes on
+            slack[q] = slack[q + 1]
+            continue
+        served_s = (stop.service_start - start).total_seconds()
+        windows = day.windows_s[order[q]] if day.windows_s is not None else ()
+        window = next_window(served_s, windows)
+        closes = math.inf if window is None else window[1]
+        slack[q] = stop.wait_s + min(closes - served_s, slack[q + 1])
+    return slack
 
 
 def _energy_j(result: PlanResult, first: int, end: int) -> float:

@@ -19,7 +19,6 @@ from numpy.typing import NDArray
 
 from core.clock import check_representable, departure
 from core.exceptions import (
-    InvalidParameterError,
     InvalidStopsError,
     LimitExceededError,
     NoRouteError,
@@ -34,7 +33,7 @@ from core.planning.model import (
     PlanProblem,
     PlanResult,
     Solved,
-    check_stop_ids,
+    check_places,
 )
 from core.planning.recharge import charging_not_planned, with_charges
 from core.planning.scene import Scene, legs_for, round_field, round_places, weather_service_for
@@ -215,13 +214,7 @@ def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
     payload, the time zone and start time, the client's matrix. Raises
     :class:`core.exceptions.CoreError` naming the field; returns the departure and the zone's
     name."""
-    check_stop_ids(problem.depot, problem.stops, problem.chargers)
-    if problem.chargers and problem.matrix is not None:
-        raise InvalidParameterError(
-            "a client matrix has no rows for the chargers on the way: leave out matrix (the "
-            "planner estimates the legs or asks its router) or chargers",
-            "chargers",
-        )
+    check_places(problem)
     # In the solver's units, so that a round accepted here fits the solver's payload too.
     delivered = sum(stop.delivery_kg for stop in problem.stops)
     taken = int(payload_units_up([stop.delivery_kg for stop in problem.stops]).sum())

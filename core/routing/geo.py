@@ -63,6 +63,18 @@ class Legs:
         """Street type of the leg from ``i`` to ``j``."""
         return STREET_TYPE_NAMES[int(self.street_type[i, j])]
 
+    def first(self, count: int) -> Legs:
+        """The legs among the first ``count`` places."""
+        square = (slice(count), slice(count))
+        return Legs(
+            distance_m=self.distance_m[square],
+            duration_s=self.duration_s[square],
+            grade=self.grade[square],
+            street_type=self.street_type[square],
+            source=self.source,
+            snap_distance_m=None if self.snap_distance_m is None else self.snap_distance_m[:count],
+        )
+
     def unreachable(self) -> list[int]:
         """Places with no road from or to the depot (a router's null), by index (≥ 1)."""
         known = np.isfinite(self.distance_m) & np.isfinite(self.duration_s)

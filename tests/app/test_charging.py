@@ -48,11 +48,13 @@ def test_the_charging_example_comes_back_to_charge_and_holds_its_reserve(client)
     assert body["battery"]["min_soc"] >= 0.1
 
 
-def test_a_fleet_with_a_depot_charger_says_it_does_not_charge(client):
+def test_a_fleet_with_a_depot_charger_plans_with_it(client):
     depot = FLEET_PLAN_EXAMPLE["depot"] | {"charger": {"power_kw": 22}}
     response = client.post("/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE | {"depot": depot})
     assert response.status_code == 200
-    assert any("chargers are not used" in w for w in response.json()["warnings"])
+    body = response.json()
+    assert not any("not used" in w for w in body["warnings"])
+    assert all("charges" in route for route in body["routes"])
 
 
 @pytest.mark.parametrize(
@@ -141,11 +143,18 @@ def test_the_en_route_example_charges_at_the_fast_charger_on_the_way(client):
     assert points and all(p["geometry"]["coordinates"] == [16.40, 48.215] for p in points)
 
 
-def test_a_fleet_with_chargers_on_the_way_says_it_does_not_charge(client):
-    chargers = EN_ROUTE_CHARGING_EXAMPLE["chargers"]
+def test_a_fleet_with_chargers_on_the_way_names_a_bad_one(client):
+    chargers = [
+        *EN_ROUTE_CHARGING_EXAMPLE["chargers"],
+        {"id": "x", "lat": 48.2, "lon": 16.3, "power_kw": 0},
+    ]
     response = client.post("/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE | {"chargers": chargers})
-    assert response.status_code == 200
-    assert any("chargers are not used" in w for w in response.json()["warnings"])
+    assert response.status_code == 422
+    assert response.json()["errors"][0]["field"] == "chargers[2].power_kw"
+    twice = [chargers[0], chargers[0]]
+    response = client.post("/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE | {"chargers": twice})
+    assert response.status_code == 422
+    assert response.json()["errors"][0]["field"] == "chargers[1].id"
 
 
 CHARGER = {"id": "hpc", "lat": 48.215, "lon": 16.40, "power_kw": 150}

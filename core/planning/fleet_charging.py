@@ -1,0 +1,165 @@
+"""Charging in a fleet's day: the stops the search left out because no battery lasted are
+served by vans that charge between stops — at the depot's charger or on the way — and a
+charge point busy with another van of the fleet is not free.
+
+After the search (:mod:`core.planning.fleet`) every route holds without charging. Each stop
+left out for its battery is then tried in the vans' routes at its cheapest places by distance
+on the objective (:data:`POSITIONS_TRIED` per van) and in a van not driving yet: the route
+simulated with the charges it needs (:func:`core.planning.recharge.with_charges`, from the
+charges it had: every later window and the shift's end kept, the charge points free only
+between the other vans' charges). The first that holds — fewer charges by the estimates
+first, then what the objective gains, a van already driving before a new one when the fleet
+is to be small — takes the stop; its charges are booked on their charge points. A stop
+no van can take so is left out as before, its detail saying that charging did not help.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+from core.params import ChargePoint, Place
+from core.planning.day import FleetDay
+from core.planning.model import DEPOT_CHARGER_ID, PlanProblem, PlanResult, Unassigned
+from core.planning.recharge import Busy, visits_of
+from core.planning.scene import charge_points
+from core.planning.timeline import ChargeVisit
+from core.planning.verify import route_failure
+
+#: Places in each van's route a left-out stop is tried at, cheapest by distance first.
+POSITIONS_TRIED = 3
+
+
+@dataclass
+class Bookings:
+    """The charges of the fleet's vans on each charge point (by place index): who charges
+    from when to when."""
+
+    points: dict[int, ChargePoint]
+    spans: dict[int, list[tuple[dt.datetime, dt.datetime, str]]] = field(default_factory=dict)
+
+    def book(self, van_id: str, place_of: dict[str, int], result: PlanResult) -> None:
+        """Van ``van_id``'s charges, in place of any it had before."""
+        for place, spans in self.spans.items():
+            self.spans[place] = [s for s in spans if s[2] != van_id]
+        for charge in result.charges:
+            place = 0 if charge.charger_id == DEPOT_CHARGER_ID else place_of[charge.charger_id]
+            self.spans.setdefault(place, []).append((charge.arrive, charge.depart, van_id))
+
+    def busy(self, van_id: str) -> Busy:
+        """When the other vans take every point of each charger."""
+        out: dict[int, list[tuple[dt.datetime, dt.datetime]]] = {}
+        for place, spans in self.spans.items():
+            others = [(a, b) for a, b, v in spans if v != van_id]
+            out[place] = _full(others, self.points[place].points)
+        return out
+
+
+def _full(
+    spans: list[tuple[dt.datetime, dt.datetime]], points: int
+) -> list[tuple[dt.datetime, dt.datetime]]:
+    """When at least ``points`` of ``spans`` overlap."""
+    events = sorted([(a, 1) for a, _ in spans] + [(b, -1) for _, b in spans])
+    full, taken, since = [], 0, None
+    for moment, step in events:
+        taken += step
+        if taken >= points and since is None:
+            since = moment
+        elif taken < points and since is not None:
+            if moment > since:
+                full.append((since, moment))
+            since = None
+    return full
+
+
+def serve_with_charging(
+    day: FleetDay,
+    routes: list[list[int]],
+    results: dict[int, PlanResult],
+    unassigned: list[Unassigned],
+    minimize_vehicles: bool,
+    deadline: float,
+) -> tuple[list[list[int]], dict[int, PlanResult], list[Unassigned]]:
+    """The fleet's routes (stops per van), their simulations and the stops left out, with the
+    stops left out for their battery served by vans that charge where they can; the rest of
+    ``unassigned`` as it was."""
+    places = day.scene.places
+    bookings = Bookings(charge_points(day.shifts[0].problem))
+    place_of = {place.id: k for k, place in enumerate(places)}
+    served: set[int] = set()
+    for stop in unassigned:
+        if stop.reason != "battery" or time.perf_counter() >= deadline:
+            continue
+        node = place_of[stop.id]
+        for v, route in _candidates(day, routes, node, minimize_vehicles):
+            if time.perf_counter() >= deadline:
+                break
+            shift = day.shifts[v]
+            order, charges = _with_stop(shift.problem, places, results.get(v), route, node)
+            result = day.charged(v, order, charges, bookings.busy(shift.id))
+            if route_failure(shift.id, shift.problem, places, result, shift.end, True) is None:
+                routes[v], results[v] = route, result
+                bookings.book(shift.id, place_of, result)
+                served.add(node)
+                break
+    left = [
+        replace(
+            u,
+            detail=f"{u.detail}; charging did not let a van serve it either (no "
+            "charger within reach, or no time for the charge)",
+        )
+        if u.reason == "battery"
+        else u
+        for u in unassigned
+        if place_of[u.id] not in served
+    ]
+    return routes, results, left
+
+
+def _with_stop(
+    problem: PlanProblem,
+    places: list[Place],
+    driven: PlanResult | None,
+    route: list[int],
+    node: int,
+) -> tuple[list[int], dict[int, ChargeVisit]]:
+    """The order a van drives ``route`` (its stops, ``node`` among them) in, keeping the
+    chargers and charges of what it drove before (``driven``, without ``node``)."""
+    if driven is None:
+        return [0, *route, 0], {}
+    order, charges = visits_of(problem, places, driven)
+    k = route.index(node)
+    after = 0 if k == 0 else order.index(route[k - 1])
+    order = [*order[: after + 1], node, *order[after + 1 :]]
+    return order, {q + (q > after): c for q, c in charges.items()}
+
+
+def _candidates(
+    day: FleetDay, routes: list[list[int]], node: int, minimize_vehicles: bool
+) -> list[tuple[int, list[int]]]:
+    """Each van's route with ``node`` at its cheapest places on the objective, and ``node``
+    alone for a van not driving, best first: fewer charges by the estimates (the energy
+    beyond the battery, in batteries), then what the objective gains; the vans not driving
+    after the others when the fleet is to be small."""
+    options: list[tuple[bool, int, float, int, list[int]]] = []
+    idle: set[tuple[int, tuple[float, float]]] = set()
+    for v, route in enumerate(routes):
+        estimates = day.estimates[v]
+        kind = (id(estimates), day.shift_s[v])
+        if not route and kind in idle:
+            continue  # a van like one tried already
+        if not route:
+            idle.add(kind)
+        before = estimates.route_cost(route)
+        tried = sorted(
+            (estimates.route_cost(longer) - before, longer)
+            for longer in ([*route[:k], node, *route[k:]] for k in range(len(route) + 1))
+        )
+        for extra, longer in tried[:POSITIONS_TRIED]:
+            beyond = estimates.route_energy_j(longer) / max(estimates.budget_j, 1.0) - 1.0
+            charges = max(math.ceil(beyond), 0)
+            options.append((minimize_vehicles and not route, charges, extra, v, longer))
+    options.sort(key=lambda o: o[:3])
+    return [(v, route) for *_, v, route in options]

@@ -1,0 +1,109 @@
+"""Charging in a fleet: the summer day's 40 stops (tests/core/planning/test_recharge.py) that
+one 40 kWh van leaves half of for its battery are all served with a charger on the way, the
+EU break kept; vans that charge at one charge point never charge at once; the bookings say
+when a charger is full."""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import numpy as np
+import pytest
+
+from core.params import BatteryParams, Charger, ChargePoint, Depot, Stop
+from core.planning.fleet import plan_fleet
+from core.planning.fleet_charging import Bookings
+from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
+from core.planning.timeline import MAX_DRIVING_S
+from tests.core.planning.test_breaks import driving_between_breaks_s
+from tests.core.planning.test_recharge import summer_day
+
+FAST = Charger(id="hpc-prater", lat=48.215, lon=16.40, power_kw=150, price_per_kwh=0.59)
+
+
+def fleet(problem, vans, **fields) -> FleetProblem:
+    return FleetProblem(
+        **fields_of(problem, RoundFields) | fields,
+        vehicles=[
+            FleetVehicle(id=f"van-{k}", shift_start="07:00", shift_end="21:00", van=van)
+            for k, van in enumerate(vans)
+        ],
+        time_limit_s=8,
+    )
+
+
+@pytest.fixture(scope="module")
+def one_van():
+    day = summer_day(None)
+    return plan_fleet(fleet(day, [day.van])), plan_fleet(fleet(day, [day.van], chargers=[FAST]))
+
+
+def test_the_stops_a_battery_left_out_are_served_with_a_charger(one_van):
+    without, charged = one_van
+    left = [u for u in without.unassigned if u.reason == "battery"]
+    assert len(left) >= 10
+    served = {s.id for r in charged.routes for s in r.plan.stops}
+    assert len(served) >= 40 - len(without.unassigned) + 10
+    assert {u.id for u in left} & served
+    (route,) = charged.routes
+    plan = route.plan
+    assert plan.charges and {c.charger_id for c in plan.charges} == {"hpc-prater"}
+    # the simulation with the charges in it holds: reserve, shift, the EU break rule
+    assert plan.battery.feasible and plan.battery.min_soc >= 0.1
+    assert plan.legs[-1].arrive.time() <= dt.time(21, 0)
+    assert plan.breaks and max(driving_between_breaks_s(plan)) <= MAX_DRIVING_S + 1
+    assert not any("not used" in w for w in charged.warnings)
+    for u in charged.unassigned:
+        if u.reason == "battery":
+            assert "charging did not let a van serve it" in u.detail
+
+
+def two_clusters() -> FleetProblem:
+    """Two vans of 12 kWh, each with 12 stops 10 km out (east and west, 8 min each): each
+    needs a charge at mid-morning, at the depot's one-point charger."""
+    rng = np.random.default_rng(5)
+    stops = [
+        Stop(
+            id=f"{side}{k}",
+            lat=48.21 + rng.uniform(-0.02, 0.02),
+            lon=16.37 + sign * (0.135 + rng.uniform(-0.02, 0.02)),
+            service_time_s=480,
+            door_open_s=120,
+        )
+        for side, sign in (("E", 1), ("W", -1))
+        for k in range(12)
+    ]
+    day = summer_day(None)
+    van = day.van.model_copy(update={"battery": BatteryParams(usable_capacity_kwh=12.0)})
+    depot = Depot(id="depot", lat=48.21, lon=16.37, charger=ChargePoint(power_kw=22, points=1))
+    base = day.model_copy(update={"stops": stops, "depot": depot})
+    return fleet(base, [van, van], minimize_vehicles=False)
+
+
+def test_vans_at_a_one_point_charger_never_charge_at_once():
+    result = plan_fleet(two_clusters())
+    charging = [(c.arrive, c.depart) for r in result.routes for c in r.plan.charges]
+    assert len({r.vehicle_id for r in result.routes if r.plan.charges}) == 2
+    charging.sort()
+    for (_, ends), (begins, _) in zip(charging, charging[1:], strict=False):
+        assert begins >= ends  # the second van waits (or charges later) while the first charges
+
+
+def test_bookings_say_when_every_point_is_taken():
+    moment = dt.datetime(2026, 7, 15, 9, tzinfo=dt.UTC)
+
+    def at(minutes: float) -> dt.datetime:
+        return moment + dt.timedelta(minutes=minutes)
+
+    one, two = ChargePoint(power_kw=50, points=1), ChargePoint(power_kw=50, points=2)
+    bookings = Bookings({0: one, 5: two})
+    bookings.spans = {
+        0: [(at(0), at(30), "a"), (at(60), at(90), "b")],
+        5: [(at(0), at(30), "a"), (at(10), at(50), "b"), (at(40), at(70), "c")],
+    }
+    busy = bookings.busy("z")
+    assert busy[0] == [(at(0), at(30)), (at(60), at(90))]
+    assert busy[5] == [(at(10), at(30)), (at(40), at(50))]  # both points taken
+    # a van's own charges do not block it
+    assert bookings.busy("a")[0] == [(at(60), at(90))]
+    assert bookings.busy("b")[5] == []
