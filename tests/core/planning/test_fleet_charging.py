@@ -10,7 +10,7 @@ import datetime as dt
 import numpy as np
 import pytest
 
-from core.params import BatteryParams, Charger, ChargePoint, Depot, Stop
+from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop
 from core.planning.fleet import plan_fleet
 from core.planning.fleet_charging import Bookings
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
