@@ -6,6 +6,7 @@ when a charger is full."""
 from __future__ import annotations
 
 import datetime as dt
+import itertools
 
 import numpy as np
 import pytest
@@ -85,7 +86,7 @@ def test_vans_at_a_one_point_charger_never_charge_at_once():
     charging = [(c.arrive, c.depart) for r in result.routes for c in r.plan.charges]
     assert len({r.vehicle_id for r in result.routes if r.plan.charges}) == 2
     charging.sort()
-    for (_, ends), (begins, _) in zip(charging, charging[1:], strict=False):
+    for (_, ends), (begins, _) in itertools.pairwise(charging):
         assert begins >= ends  # the second van waits (or charges later) while the first charges
 
 
