@@ -7,7 +7,16 @@ from benchmarks import (
     bench_roads,
     bench_serving,
     bench_studies,
+    evrptw,
 )
 
-for module in (bench_energy, bench_planner, bench_roads, bench_studies, bench_fleet, bench_serving):
+for module in (
+    bench_energy,
+    bench_planner,
+    bench_roads,
+    bench_studies,
+    bench_fleet,
+    evrptw,
+    bench_serving,
+):
     module.main()

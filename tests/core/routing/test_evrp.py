@@ -1,0 +1,195 @@
+"""Routing with recharging stations (core/routing/evrp.py): a route on a line whose charges
+and times are worked by hand, a window that charging makes unreachable, the lateness a
+penalty counts, a small instance against every split and order, and the benchmark command on
+a shared instance, its answer checked by the rules alone (benchmarks/evrptw.py)."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import subprocess
+import sys
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from benchmarks.evrptw import FOLDER, check, read
+from core.routing.evrp import (
+    NO_ROUTE,
+    EvrpInstance,
+    _station_candidates,
+    route_with_stations,
+    solve_evrptw,
+)
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def instance(
+    xy: list[tuple[float, float]], kinds: str, due: float = 1000.0, **changes
+) -> EvrpInstance:
+    """Places at ``xy`` (``kinds``: d depot, c customer, f station), unit speed and energy."""
+    points = np.array(xy, dtype=float)
+    distance = np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
+    n = len(xy)
+    fields = {
+        "distance": distance,
+        "duration": distance.copy(),
+        "ready": np.zeros(n),
+        "due": np.full(n, due),
+        "service": np.zeros(n),
+        "demand": np.array([1.0 if k == "c" else 0.0 for k in kinds]),
+        "customers": [i for i, k in enumerate(kinds) if k == "c"],
+        "stations": [i for i, k in enumerate(kinds) if k == "f"],
+        "capacity": 100.0,
+        "battery": 50.0,
+        "energy_per_distance": 1.0,
+        "time_per_energy": 2.0,
+    }
+    return EvrpInstance(**(fields | changes))
+
+
+def on_a_line(**changes) -> EvrpInstance:
+    # depot at 0, customer at 40, station at 20; battery 50: 80 there and back needs charging
+    return instance([(0, 0), (40, 0), (20, 0)], "dcf", **changes)
+
+
+def charged(inst: EvrpInstance, route: list[int], penalty: float = math.inf):
+    candidates = _station_candidates(inst.distance, np.array(inst.stations))
+    return route_with_stations(inst, route, candidates, penalty)
+
+
+def test_a_route_on_a_line_charges_what_the_way_to_the_next_charge_takes():
+    # D→S: 20 (30 left); S→C→S takes 40: charge 10; C→S leaves 0; S→D takes 20: charge 20.
+    # Charging only before the customer cannot do (S→C→D takes 60 > 50); nor only after.
+    result = charged(on_a_line(), [1])
+    assert result.distance == pytest.approx(80.0)
+    assert [(v.place, v.charge) for v in result.visits] == [
+        (0, 0.0),
+        (2, pytest.approx(10.0)),
+        (1, 0.0),
+        (2, pytest.approx(20.0)),
+        (0, 0.0),
+    ]
+    assert result.warp == 0.0
+
+
+def test_a_window_that_charging_makes_unreachable_is_no_route():
+    # the customer is reached at 20 + 2·10 (charging) + 20 = 60 at the earliest
+    due = np.array([1000.0, 60.0, 1000.0])
+    assert charged(on_a_line(due=due), [1]).distance == pytest.approx(80.0)
+    late = np.array([1000.0, 50.0, 1000.0])
+    assert charged(on_a_line(due=late), [1]) is NO_ROUTE
+    # with a penalty per unit of time late it is a route 10 late, served at its close
+    penalised = charged(on_a_line(due=late), [1], penalty=3.0)
+    assert penalised.warp == pytest.approx(10.0)
+    assert penalised.cost(3.0) == pytest.approx(80.0 + 30.0)
+
+
+def test_no_station_within_reach_and_too_much_load_are_no_route():
+    far = instance([(0, 0), (40, 0), (0, 60)], "dcf")  # the station is farther than the way
+    assert charged(far, [1]) is NO_ROUTE
+    assert charged(on_a_line(capacity=0.5), [1]) is NO_ROUTE
+    # a route the battery covers needs no station
+    near = instance([(0, 0), (20, 0), (10, 0)], "dcf")
+    assert [v.place for v in charged(near, [1]).visits] == [0, 1, 0]
+
+
+SMALL_XY = [(0, 0), (30, 5), (28, -8), (-25, 10), (-30, -12), (5, 32), (15, 0), (-15, 0), (0, 20)]
+
+
+@cache
+def small() -> EvrpInstance:
+    """Five customers around a depot, three stations between, windows, load 3 per vehicle."""
+    due = np.array([400.0, 120.0, 200.0, 150.0, 260.0, 300.0, 400.0, 400.0, 400.0])
+    ready = np.array([0.0, 40.0, 0.0, 0.0, 80.0, 0.0, 0.0, 0.0, 0.0])
+    return instance(
+        SMALL_XY,
+        "dcccccfff",
+        due=due,
+        ready=ready,
+        service=np.array([0.0, 10, 10, 10, 10, 10, 0, 0, 0]),
+        capacity=3.0,
+        battery=70.0,
+        time_per_energy=1.0,
+    )
+
+
+def every_split_and_order(inst: EvrpInstance) -> tuple[int, float]:
+    """Fewest vehicles, then least distance, over every split of the customers into routes
+    and every order of each route."""
+    customers = inst.customers
+    best_route: dict[frozenset[int], float] = {}
+    for size in range(1, len(customers) + 1):
+        for group in itertools.combinations(customers, size):
+            best_route[frozenset(group)] = min(
+                charged(inst, list(order)).distance for order in itertools.permutations(group)
+            )
+
+    @cache
+    def best(left: frozenset[int]) -> tuple[int, float]:
+        if not left:
+            return (0, 0.0)
+        first = min(left)
+        out = (10**6, math.inf)
+        rest = sorted(left - {first})
+        for size in range(len(rest) + 1):
+            for others in itertools.combinations(rest, size):
+                group = frozenset({first, *others})
+                if math.isfinite(best_route[group]):
+                    vans, distance = best(left - group)
+                    out = min(out, (vans + 1, distance + best_route[group]))
+        return out
+
+    return best(frozenset(customers))
+
+
+def test_a_small_instance_is_solved_as_well_as_every_split_and_order_allows():
+    inst = small()
+    vans, distance = every_split_and_order(inst)
+    assert vans < 10**6
+    solution = solve_evrptw(inst, time_limit_s=2.0)
+    assert solution.vehicles == vans
+    assert solution.distance == pytest.approx(distance, rel=1e-6)
+    routes = [[(v.place, v.charge) for v in route] for route in solution.routes]
+    assert check(inst, routes) is None
+
+
+def test_the_independent_check_names_what_a_route_breaks():
+    inst = on_a_line()
+    assert check(inst, [[(0, 0.0), (1, 0.0), (0, 0.0)]]) == "route 0 runs empty before place 0"
+    overcharged = [[(0, 0.0), (2, 30.0), (1, 0.0), (2, 20.0), (0, 0.0)]]
+    assert "beyond the battery" in (check(inst, overcharged) or "")
+    assert check(inst, [[(0, 0.0), (2, 10.0), (1, 0.0), (2, 20.0), (0, 0.0)]]) is None
+
+
+def test_the_benchmark_command_answers_one_checked_json_line_per_instance():
+    path = FOLDER / "c101_21.txt"
+    done = subprocess.run(
+        [sys.executable, "-m", "benchmarks.evrptw", str(path), "--time-limit", "3"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+        check=True,
+    )
+    (line,) = done.stdout.splitlines()
+    answer = json.loads(line)
+    assert answer["instance"] == "c101" and answer["feasible"] is True
+    parsed = read(path)
+    index = {name: k for k, name in enumerate(parsed.ids)}
+    routes = [[(index[v["id"]], v["charge"]) for v in route] for route in answer["routes"]]
+    assert check(parsed.problem, routes) is None
+    assert answer["vehicles"] == len(routes) >= 12  # the best known is 12
+    assert all(route[0]["id"] == "D0" == route[-1]["id"] for route in answer["routes"])
+    bad = subprocess.run(
+        [sys.executable, "-m", "benchmarks.evrptw", str(path), "--time-limit", "nan"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=60,
+    )
+    assert bad.returncode == 2 and "--time-limit" in bad.stderr
