@@ -34,8 +34,8 @@ POSITIONS_TRIED = 3
 
 @dataclass
 class Bookings:
-    """The charges of the fleet's vans on each charge point (by place index): who charges
-    from when to when."""
+    """The charges of the fleet's vans on each charge point (by place index): who is plugged
+    in from when to when."""
 
     points: dict[int, ChargePoint]
     spans: dict[int, list[tuple[dt.datetime, dt.datetime, str]]] = field(default_factory=dict)
@@ -44,9 +44,12 @@ class Bookings:
         """Van ``van_id``'s charges, in place of any it had before."""
         for place, spans in self.spans.items():
             self.spans[place] = [s for s in spans if s[2] != van_id]
-        for charge in result.charges:
+        for charge in result.charges:  # plugged in: from after any wait to the departure
             place = 0 if charge.charger_id == DEPOT_CHARGER_ID else place_of[charge.charger_id]
-            self.spans.setdefault(place, []).append((charge.arrive, charge.depart, van_id))
+            plugged = dt.timedelta(minutes=charge.minutes + self.points[place].plug_minutes)
+            self.spans.setdefault(place, []).append(
+                (charge.depart - plugged, charge.depart, van_id)
+            )
 
     def busy(self, van_id: str) -> Busy:
         """When the other vans take every point of each charger."""

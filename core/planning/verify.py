@@ -9,7 +9,7 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -92,9 +92,14 @@ def simulate_route(
     timeline = laid_out(start, windows_s)
     if windows_s is not None:
         delay_s = later_departure_s(timeline, order, windows_s, latest_return_s)
-        if delay_s > 0:
+        if delay_s > 0:  # every span after the departure comes as much nearer
             start = at(start, delay_s)
             windows_s = [[(a - delay_s, b - delay_s) for a, b in place] for place in windows_s]
+            if charges:
+                charges = {
+                    q: replace(c, open_s=[(a - delay_s, b - delay_s) for a, b in c.open_s])
+                    for q, c in charges.items()
+                }
             timeline = laid_out(start, windows_s)
     check_representable(start, timeline.duration_s, "date")
     weather, warnings = scene.weather_for(start, timeline.duration_s)
