@@ -16,6 +16,7 @@ from app.schemas.plans import (
     PlanFeatureCollection,
     PlanRequest,
     PlanResponse,
+    ReloadOut,
     SolverOut,
     StopOut,
     Totals,
@@ -68,6 +69,7 @@ def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanRes
         legs=legs,
         stops=stops,
         charges=[ChargeOut(**vars(charge)) for charge in result.charges],
+        reloads=[ReloadOut(**vars(reload)) for reload in result.reloads],
         breaks=[BreakOut(**vars(rest)) for rest in result.breaks],
         totals=Totals(
             distance_m=result.distance_m,
@@ -133,6 +135,13 @@ def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> Plan
             Feature(
                 geometry=Point(coordinates=(charge.lon, charge.lat)),
                 properties={"kind": "charge"} | ChargeOut(**vars(charge)).model_dump(mode="json"),
+            )
+        )
+    for reload in result.reloads:
+        features.append(
+            Feature(
+                geometry=Point(coordinates=(depot_lon, depot_lat)),
+                properties={"kind": "reload"} | ReloadOut(**vars(reload)).model_dump(mode="json"),
             )
         )
     for index, leg in enumerate(result.legs):

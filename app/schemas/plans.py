@@ -116,6 +116,14 @@ class ChargeOut(ApiModel):
     lon: float = Field(..., description="The charger's longitude [°].")
 
 
+class ReloadOut(ApiModel):
+    """A return to the depot to reload, where it happens in the timeline."""
+
+    arrive: dt.datetime = Field(..., description="Arrival at the depot, local time.")
+    depart: dt.datetime = Field(..., description="Departure with the new load, local time.")
+    payload_kg: float = Field(..., description="Payload aboard when it leaves [kg].")
+
+
 class BreakOut(ApiModel):
     """A driver's break, parked (cab and refrigeration drawing)."""
 
@@ -174,6 +182,10 @@ class PlanResponse(ApiModel):
         description="The charges between stops (the tour shows each charger visited), in "
         "order; the legs' and stops' states of charge and the battery verdict include them.",
     )
+    reloads: list[ReloadOut] = Field(
+        default_factory=list,
+        description="The returns to the depot to reload (the tour shows each), in order.",
+    )
     breaks: list[BreakOut] = Field(
         default_factory=list, description="The driver's breaks, in order (between stops)."
     )
@@ -205,8 +217,8 @@ class Feature(ApiModel):
 class PlanFeatureCollection(ApiModel):
     """The plan as a GeoJSON FeatureCollection: the depot and stops as Points (id, arrival,
     door heat, state of charge), each charge as a Point where it happens (kind "charge", the
-    fields of `charges[]`), the legs as LineStrings (energy per consumer, state of charge at
-    both ends)."""
+    fields of `charges[]`), each reload at the depot (kind "reload"), the legs as LineStrings
+    (energy per consumer, state of charge at both ends)."""
 
     type: Literal["FeatureCollection"] = Field(
         "FeatureCollection", description="Always FeatureCollection."

@@ -116,6 +116,9 @@ def fields_of(source: Params, fields: type[Params]) -> dict[str, Any]:
     return {name: getattr(source, name) for name in fields.model_fields}
 
 
+#: Most trips of one round, and the longest reload [min].
+MAX_TRIPS = 20
+MAX_RELOAD_MINUTES = 240.0
 #: Longest fixed break [min]: half a day.
 MAX_BREAK_MINUTES = 720.0
 
@@ -193,6 +196,18 @@ class PlanFields(RoundFields):
     keep_order: bool = Field(False, description="Drive the stops in the given order.")
     time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT_S)
     breaks: Breaks = breaks_field("none")
+    max_trips: int = Field(
+        1,
+        ge=1,
+        le=MAX_TRIPS,
+        description="Most trips from the depot (1–20): with more than 1, a round whose stops "
+        "take more than payload_kg comes back to reload (its payload back to payload_kg) "
+        "before the stop it could not carry. Returns to charge do not count. Rounds without "
+        "time windows and without start_state.",
+    )
+    reload_minutes: float = Field(
+        15.0, ge=0, le=MAX_RELOAD_MINUTES, description="Minutes to reload at the depot, 0–240."
+    )
     start_state: StartState | None = Field(
         None,
         description="Plan the rest of a day from where the van is (its position, time, charge, "
@@ -379,6 +394,16 @@ class ChargeResult:
 
 
 @dataclass(frozen=True)
+class ReloadResult:
+    """A return to the depot to reload: when the van arrives and leaves, and the payload it
+    leaves with [kg]."""
+
+    arrive: dt.datetime
+    depart: dt.datetime
+    payload_kg: float
+
+
+@dataclass(frozen=True)
 class BreakResult:
     """A driver's break: when, and why ("eu-561" or "fixed")."""
 
@@ -442,6 +467,7 @@ class PlanResult:
     profile: DayProfile
     late_stops: list[str]
     charges: list[ChargeResult] = field(default_factory=list)
+    reloads: list[ReloadResult] = field(default_factory=list)
     breaks: list[BreakResult] = field(default_factory=list)
 
 

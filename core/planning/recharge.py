@@ -109,7 +109,10 @@ def with_charges(
         return charged.result
     charged = _charged_until_it_holds(day, points, charged)
     result = charged.result
-    if orders is not None and charged.charges and result.battery.feasible:
+    reloads = any(  # the tour again would lose the returns to reload
+        place == 0 and q not in charged.charges for q, place in enumerate(charged.order[1:-1], 1)
+    )
+    if orders is not None and charged.charges and result.battery.feasible and not reloads:
         result = _better_orders(day, points, charged, orders)
     if not result.battery.feasible:
         leg = result.first_infeasible_leg

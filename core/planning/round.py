@@ -36,13 +36,13 @@ from core.planning.model import (
     check_places,
 )
 from core.planning.recharge import charging_not_planned, with_charges
+from core.planning.reloads import check_payload, with_reloads
 from core.planning.scene import Scene, legs_for, round_field, round_places, weather_service_for
 from core.planning.start_state import check_start, path_tour, under_way
 from core.planning.timeline import client_legs_too_fast, windows_after
 from core.routing.geo import Legs, build_legs
 from core.routing.roads import LegRoute, RememberingRouter, RoadRouter
 from core.routing.tsp import Tour, solve_path, solve_tour
-from core.routing.units import payload_units_down, payload_units_up
 
 #: Search budget for each stretch between charges of a round [s]: stretches are short enough
 #: for CP-SAT's proof within it.
@@ -91,7 +91,7 @@ def plan(
     cost, unit_value, offset = cost_matrix(problem, legs, start)
     tours = _Tours(cost, len(places) - len(problem.chargers), problem.start_state is not None)
     tour = tours.first(problem.time_limit_s, problem.keep_order)
-    order = tour.order
+    order = with_reloads(problem, tour.order, None if problem.keep_order else tours.stretch)
     round_s = float(legs.duration_s[order[:-1], order[1:]].sum()) + sum(
         stop.service_time_s for stop in problem.stops
     )
@@ -215,15 +215,7 @@ def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
     :class:`core.exceptions.CoreError` naming the field; returns the departure and the zone's
     name."""
     check_places(problem)
-    # In the solver's units, so that a round accepted here fits the solver's payload too.
-    delivered = sum(stop.delivery_kg for stop in problem.stops)
-    taken = int(payload_units_up([stop.delivery_kg for stop in problem.stops]).sum())
-    if taken > payload_units_down(problem.van.payload_kg):
-        raise InvalidStopsError(
-            f"the stops' delivery_kg add up to {delivered:g} kg, more than the payload "
-            f"{problem.van.payload_kg:g} kg",
-            "stops",
-        )
+    check_payload(problem)
     start, timezone_name = round_start(problem)
     if problem.matrix is not None:
         build_legs(problem.places, problem.matrix)

@@ -274,6 +274,7 @@ class Timeline:
     capped_s: float = 0.0
     charging: list[ChargingSpell] = field(default_factory=list)
     charged_at: list[int] = field(default_factory=list)
+    reloaded_at: list[int] = field(default_factory=list)
     breaks: list[Break] = field(default_factory=list)
 
     @property
@@ -303,6 +304,7 @@ class _Builder:
     capped_s: float = 0.0
     charging: list[ChargingSpell] = field(default_factory=list)
     charged_at: list[int] = field(default_factory=list)
+    reloaded_at: list[int] = field(default_factory=list)
     rest: Rest = field(default_factory=Rest)
     driving_s: float = 0.0
     breaks: list[Break] = field(default_factory=list)
@@ -423,6 +425,17 @@ class _Builder:
         if self.rest.eu_561 and (self.clock - arrival) * PLAN_DT_S >= EU_BREAK_S:
             self.counts_as_break(arrival, "eu-561")  # charged (or waited) during the break
 
+    def reload(self, position: int, duration_s: float, payload_kg: float) -> None:
+        """Stand at the depot (place ``position`` of the order) for ``duration_s``, parked,
+        and leave with ``payload_kg`` aboard."""
+        self.marks["serve"].append(self.clock)
+        self.reloaded_at.append(position)
+        self.payload_kg = payload_kg
+        start = self.clock
+        self.stand_parked(math.ceil(duration_s / PLAN_DT_S))
+        if self.rest.eu_561 and duration_s >= EU_BREAK_S:  # reloaded during the break
+            self.counts_as_break(start, "eu-561")
+
     def finish(self) -> Timeline:
         marks = {name: np.array(values) for name, values in self.marks.items()}
         return Timeline(
@@ -442,6 +455,7 @@ class _Builder:
             capped_s=self.capped_s,
             charging=self.charging,
             charged_at=self.charged_at,
+            reloaded_at=self.reloaded_at,
             breaks=self.breaks,
         )
 
@@ -484,6 +498,8 @@ def build_timeline(
             day.serve(j, problem.stops[j - 1], windows_s[j] if windows_s is not None else ())
         elif charges is not None and k + 1 in charges:
             day.charge(k + 1, charges[k + 1])
+        elif j == 0 and k + 2 < len(order):  # back at the depot between stops, not to charge
+            day.reload(k + 1, problem.reload_minutes * 60, problem.van.payload_kg)
         else:
             day.marks["serve"].append(day.clock)
         day.marks["leave"].append(day.clock)

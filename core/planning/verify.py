@@ -26,6 +26,7 @@ from core.planning.model import (
     LegResult,
     PlanProblem,
     PlanResult,
+    ReloadResult,
     Solved,
     StopResult,
     UnassignedReason,
@@ -186,8 +187,11 @@ class _Split:
         places, soc, snap = self.scene.places, self.simulated.soc, self.scene.legs.snap_distance_m
         out = []
         payload = self.problem.van.payload_kg
+        reloads = set(self.timeline.reloaded_at)
         for k, j in enumerate(self.order[1:-1]):
-            if not 0 < j <= len(self.problem.stops):  # at a charger
+            if k + 1 in reloads:
+                payload = self.problem.van.payload_kg
+            if not 0 < j <= len(self.problem.stops):  # at a charger or reloading
                 continue
             b, c = int(self.timeline.arrive[k]), int(self.timeline.leave[k])
             served = int(self.timeline.serve[k])
@@ -238,6 +242,17 @@ class _Split:
             )
         return out
 
+    def reloads(self) -> list[ReloadResult]:
+        """The returns to the depot to reload."""
+        return [
+            ReloadResult(
+                self.moment(int(self.timeline.arrive[q - 1])),
+                self.moment(int(self.timeline.leave[q - 1])),
+                self.problem.van.payload_kg,
+            )
+            for q in self.timeline.reloaded_at
+        ]
+
     def profile(self) -> DayProfile:
         size = self.simulated.time_s.size
         every = max(round(PROFILE_STEP_S / PLAN_DT_S), 1)
@@ -285,6 +300,7 @@ class _Split:
             profile=self.profile(),
             late_stops=[places[j].id for j in self.timeline.late],
             charges=self.charges(),
+            reloads=self.reloads(),
             breaks=[
                 BreakResult(self.moment(round(b.start_s)), self.moment(round(b.end_s)), b.kind)
                 for b in self.timeline.breaks

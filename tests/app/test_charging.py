@@ -212,3 +212,22 @@ def test_two_chargers_of_one_id_and_a_matrix_beside_chargers_are_422(client):
     )
     assert response.status_code == 422
     assert response.json()["errors"][0]["field"] == "chargers"
+
+
+def test_a_round_heavier_than_the_van_reloads_over_http(client):
+    stops = [s | {"delivery_kg": 20} for s in CHARGING_PLAN_EXAMPLE["stops"]]
+    body = CHARGING_PLAN_EXAMPLE | {"stops": stops, "max_trips": 2, "reload_minutes": 10}
+    response = client.post("/v1/plans", json=body)
+    assert response.status_code == 200
+    answer = response.json()
+    (reload,) = answer["reloads"]
+    assert set(reload) == {"arrive", "depart", "payload_kg"}
+    assert reload["payload_kg"] == 400
+    assert answer["tour"].count("depot-centre") >= 3
+    one_trip = client.post("/v1/plans", json=body | {"max_trips": 1})
+    assert one_trip.status_code == 422
+    assert one_trip.json()["errors"][0]["field"] == "stops"
+    for bad in ({"max_trips": 0}, {"max_trips": "2.5"}, {"reload_minutes": "NaN"}):
+        refused = client.post("/v1/plans", json=body | bad)
+        assert refused.status_code == 422
+        assert refused.json()["errors"][0]["field"] == next(iter(bad))

@@ -1,0 +1,89 @@
+"""Several trips of one van: a round whose stops take more than the van carries comes back to
+the depot to reload (``max_trips``, ``reload_minutes``).
+
+The round trip's order stays: walking it from the depot, the van comes back to reload before
+the first stop whose delivery it no longer carries (the payload back to ``payload_kg``), as
+often as it must; each trip is then put in its own best order. More trips than ``max_trips``
+is an error naming the stops. The timeline stands the van at the depot, parked, for
+``reload_minutes`` (:meth:`core.planning.timeline._Builder.reload`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from core.exceptions import InvalidStopsError
+from core.planning.model import PlanProblem
+from core.routing.units import payload_units_down, payload_units_up
+
+#: A trip's places (the depot first and last) in a better order, the depot still first and last.
+Reorder = Callable[[list[int]], list[int]]
+
+
+def reloads_allowed(problem: PlanProblem) -> bool:
+    """Whether the round may come back to reload: more than one trip, no time windows, not
+    under way."""
+    windowed = any(stop.time_windows for stop in problem.stops)
+    return problem.max_trips > 1 and not windowed and problem.start_state is None
+
+
+def check_payload(problem: PlanProblem) -> None:
+    """What the stops take fits the van: in one load, or with reloads in ``max_trips`` loads
+    each stop within one; else an error naming the stops or the stop. In the solver's units,
+    so that a round accepted here fits the solver's payload too."""
+    weights = payload_units_up([stop.delivery_kg for stop in problem.stops])
+    capacity = payload_units_down(problem.van.payload_kg)
+    delivered = sum(stop.delivery_kg for stop in problem.stops)
+    payload = problem.van.payload_kg
+    if not reloads_allowed(problem):
+        if int(weights.sum()) > capacity:
+            raise InvalidStopsError(
+                f"the stops' delivery_kg add up to {delivered:g} kg, more than the payload "
+                f"{payload:g} kg (with max_trips above 1, a round without time windows comes "
+                "back to reload)",
+                "stops",
+            )
+        return
+    for index, weight in enumerate(weights):
+        if weight > capacity:
+            raise InvalidStopsError(
+                f"delivery_kg {problem.stops[index].delivery_kg:g} is more than the payload "
+                f"{payload:g} kg: no trip carries it",
+                f"stops[{index}].delivery_kg",
+            )
+    if int(weights.sum()) > capacity * problem.max_trips:
+        raise InvalidStopsError(
+            f"the stops' delivery_kg add up to {delivered:g} kg, more than {problem.max_trips} "
+            f"trips of {payload:g} kg carry",
+            "stops",
+        )
+
+
+def with_reloads(problem: PlanProblem, order: list[int], reorder: Reorder | None) -> list[int]:
+    """The round trip ``order`` (place indices, the depot first and last) with a return to
+    the depot before each stop the van no longer carries, each trip in its own best order
+    (``reorder``; None keeps the client's order); ``order`` when one load carries it all."""
+    if not reloads_allowed(problem):
+        return order
+    weights = payload_units_up([stop.delivery_kg for stop in problem.stops])
+    capacity = payload_units_down(problem.van.payload_kg)
+    trips: list[list[int]] = [[0]]
+    aboard = capacity
+    for place in order[1:-1]:
+        weight = int(weights[place - 1])
+        if weight > aboard:
+            trips[-1].append(0)
+            trips.append([0])
+            aboard = capacity
+        trips[-1].append(place)
+        aboard -= weight
+    trips[-1].append(0)
+    if len(trips) > problem.max_trips:
+        raise InvalidStopsError(
+            f"in the planned order the stops take {len(trips)} trips, more than max_trips "
+            f"{problem.max_trips}",
+            "stops",
+        )
+    if reorder is not None and len(trips) > 1:
+        trips = [reorder(trip) for trip in trips]
+    return [0, *(place for trip in trips for place in trip[1:])]

@@ -1,0 +1,91 @@
+"""Several trips: the summer day's 40 stops (tests/core/planning/test_recharge.py) at 20 kg
+each take 800 kg on a 400 kg van — two trips with a reload at the depot between — and the
+payloads, the reload's minutes and what a client may get wrong, by hand."""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import pytest
+
+from core.exceptions import InvalidParameterError, InvalidStopsError
+from core.params import TimeWindow
+from core.planning.round import plan
+from tests.core.planning.test_recharge import summer_day
+
+
+def heavy(**fields):
+    day = summer_day(None)
+    stops = [stop.model_copy(update={"delivery_kg": 20.0}) for stop in day.stops]
+    return day.model_copy(update={"stops": stops, **fields})
+
+
+@pytest.fixture(scope="module")
+def two_trips():
+    return plan(heavy(max_trips=3, reload_minutes=20))
+
+
+def test_a_round_heavier_than_the_van_comes_back_to_reload(two_trips):
+    result = two_trips
+    assert result.tour.count("depot") == 3  # out, back to reload, out again, home
+    (reload,) = result.reloads
+    back = result.tour.index("depot", 1)
+    assert result.legs[back - 1].arrive == reload.arrive
+    assert result.legs[back].depart == reload.depart
+    # 20 minutes parked at the depot, and the van leaves with its payload again
+    assert (reload.depart - reload.arrive).total_seconds() == pytest.approx(20 * 60, abs=1)
+    assert reload.payload_kg == 400
+    # 400 kg is 20 stops: the first trip unloads to 0, the second starts again from 400
+    payloads = [stop.payload_after_kg for stop in result.stops]
+    assert payloads[:20] == [400 - 20 * (k + 1) for k in range(20)]
+    assert payloads[20:] == [400 - 20 * (k + 1) for k in range(20)]
+    assert sorted(s.id for s in result.stops) == sorted(s.id for s in heavy().stops)
+
+
+def test_the_reload_is_parked_time_the_cab_and_box_draw_on(two_trips):
+    one = plan(heavy(max_trips=3, reload_minutes=0))
+    assert two_trips.duration_s == pytest.approx(one.duration_s + 20 * 60, abs=60)
+    assert two_trips.energy_kwh["refrigeration"] > one.energy_kwh["refrigeration"]
+
+
+def test_what_the_trips_cannot_carry_is_refused_naming_the_field():
+    with pytest.raises(InvalidStopsError) as caught:
+        plan(heavy())  # max_trips 1: 800 kg on 400
+    assert caught.value.field == "stops" and "max_trips" in caught.value.message
+    with pytest.raises(InvalidStopsError) as caught:
+        plan(
+            heavy(max_trips=2).model_copy(
+                update={"van": heavy().van.model_copy(update={"payload_kg": 300})}
+            )
+        )
+    assert caught.value.field == "stops" and "2 trips" in caught.value.message
+    day = heavy(max_trips=5)
+    stops = [*day.stops[:-1], day.stops[-1].model_copy(update={"delivery_kg": 450.0})]
+    with pytest.raises(InvalidStopsError) as caught:
+        plan(day.model_copy(update={"stops": stops}))
+    assert caught.value.field == "stops[39].delivery_kg"
+    # with time windows no reload is planned: the payload must fit one load
+    windowed = [
+        stops[0].model_copy(
+            update={"time_windows": [TimeWindow(start=dt.time(8), end=dt.time(18))]}
+        ),
+        *heavy().stops[1:],
+    ]
+    with pytest.raises(InvalidStopsError) as caught:
+        plan(heavy(max_trips=3).model_copy(update={"stops": windowed}))
+    assert caught.value.field == "stops"
+
+
+@pytest.mark.parametrize(
+    ("fields", "field"),
+    [
+        ({"max_trips": 0}, "max_trips"),
+        ({"max_trips": 21}, "max_trips"),
+        ({"reload_minutes": -1}, "reload_minutes"),
+        ({"reload_minutes": 241}, "reload_minutes"),
+    ],
+)
+def test_bad_trips_are_refused(fields, field):
+    with pytest.raises(InvalidParameterError) as caught:
+        type(heavy())(**(heavy().model_dump() | fields))
+    assert caught.value.field == field
