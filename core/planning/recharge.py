@@ -142,12 +142,11 @@ def _charged(
         cut = option.cut
         tried = [*order[: cut + 1], option.place, *order[cut + 1 :]]
         visits = {q + (q > cut): c for q, c in charges.items()} | {cut + 1: option.visit}
-        simulated = day.simulate(tried, visits)  # filled, then every charge fitted
-        tried, visits = _without_idle(tried, _fitted(day.problem, tried, simulated, visits))
-        simulated = day.simulate(tried, visits)
+        charged = _refitted(day, tried, visits)  # filled, then every charge fitted
+        simulated = charged.result
         reached = simulated.legs[cut].soc_end >= reserve
         if reached and simulated.battery.margin_kwh > result.battery.margin_kwh:
-            return tried, visits, simulated
+            return charged.order, charged.charges, simulated
     return None
 
 
@@ -302,10 +301,17 @@ def _better_orders(
 
 
 def _refitted(day: _Round, order: list[int], charges: dict[int, ChargeVisit]) -> _Charged:
-    """The day in ``order`` with ``charges`` (by position) fitted to what it takes."""
-    first = day.simulate(order, charges)
-    order, fitted = _without_idle(order, _fitted(day.problem, order, first, charges))
-    return _Charged(order, fitted, day.simulate(order, fitted))
+    """The day in ``order`` with ``charges`` (by position) fitted to what it takes. A visit
+    left with nothing to charge is dropped, and the others fitted again: its detour is no
+    longer driven, so the stretch it closed takes less."""
+    result = day.simulate(order, charges)
+    for _ in range(len(charges) + 1):
+        fitted = _fitted(day.problem, order, result, charges)
+        order, charges = _without_idle(order, fitted)
+        result = day.simulate(order, charges)
+        if len(charges) == len(fitted):
+            break
+    return _Charged(order, charges, result)
 
 
 def _measure(result: PlanResult) -> float:
