@@ -38,7 +38,7 @@ from typing import Protocol
 from core.params import ChargePoint, Charger, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, ChargeCurve, charge_curve
-from core.planning.model import PlanProblem, PlanResult, RoundFields, Solved
+from core.planning.model import PlanProblem, PlanResult, Solved
 from core.planning.scene import Scene, charge_points
 from core.planning.timeline import ChargeVisit, Windows, next_window, seconds_after
 from core.planning.verify import simulate_route
@@ -119,7 +119,8 @@ def with_charges(
         where = f" on the way to '{result.legs[leg].to_id}'" if leg is not None else ""
         warning = (
             f"even with charging the battery runs below its reserve{where}: no stop before it "
-            "lets the van reach an open charger with its reserve (no charger within reach)"
+            "lets the van reach an open charger with its reserve, and charge there in the time its "
+            "later windows leave (no charger within reach)"
         )
         result = replace(result, warnings=[*result.warnings, warning])
     return result
@@ -321,17 +322,6 @@ def _measure(result: PlanResult) -> float:
     if result.objective == "energy":
         return result.energy_kwh["total"]
     return result.distance_m
-
-
-def charging_not_planned(problem: RoundFields) -> list[str]:
-    """The warning of a round with time windows that does not charge although it could (its
-    search, the fleet's with one van, does not plan charges: the battery is only reported)."""
-    if problem.depot.charger is None and not problem.chargers:
-        return []
-    return [
-        "the chargers are not used: charges are planned for rounds without time windows and "
-        "for fleets (POST /v1/fleet-plans); this plan's battery verdict is without charging"
-    ]
 
 
 def _stretch_ends(order: list[int], charges: dict[int, ChargeVisit]) -> list[int]:

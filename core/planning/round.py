@@ -35,9 +35,16 @@ from core.planning.model import (
     Solved,
     check_places,
 )
-from core.planning.recharge import charging_not_planned, with_charges
+from core.planning.recharge import visits_of, with_charges
 from core.planning.reloads import check_payload, with_reloads
-from core.planning.scene import Scene, legs_for, round_field, round_places, weather_service_for
+from core.planning.scene import (
+    Scene,
+    charge_points,
+    legs_for,
+    round_field,
+    round_places,
+    weather_service_for,
+)
 from core.planning.start_state import check_start, path_tour, under_way
 from core.planning.timeline import client_legs_too_fast, windows_after
 from core.routing.geo import Legs, build_legs
@@ -179,14 +186,13 @@ def _in_windows(
 ) -> PlanResult:
     """The round when stops have time windows: the fleet search with this one van, its
     battery reported, not a constraint, and every stop required; a stop no order serves in
-    time is an error naming it."""
-    van = VanShift("van", problem, start, None, battery_enforced=False)
+    time is an error naming it. When the battery does not last and there are chargers, the
+    van charges where the time it adds keeps every later window
+    (:func:`core.planning.recharge.with_charges`)."""
     remembering = None if router is None else RememberingRouter(router)
-    routed = search(
-        fleet_day([van], scene, remembering),
-        minimize_vehicles=False,
-        deadline=started + problem.time_limit_s,
-    )
+    van = VanShift("van", problem, start, None, battery_enforced=False)
+    day = fleet_day([van], scene, remembering)
+    routed = search(day, minimize_vehicles=False, deadline=started + problem.time_limit_s)
     if routed.unassigned:
         first = routed.unassigned[0]
         index = next(k for k, stop in enumerate(problem.stops) if stop.id == first.id)
@@ -195,8 +201,13 @@ def _in_windows(
             f"no order of the round serves '{first.id}' in time: {first.detail}",
             field or f"stops[{index}]",
         )
-    result = routed.stamped(time.perf_counter() - started)[0].plan
-    return replace(result, warnings=[*result.warnings, *charging_not_planned(problem)])
+    result = routed.routes[0].plan
+    if not result.battery.feasible and charge_points(problem):
+        order, _ = visits_of(problem, scene.places, result)
+        charged = day.charged(0, order, {}, {})
+        if charged.battery.margin_kwh > result.battery.margin_kwh:
+            result = replace(charged, solved=result.solved)
+    return replace(result, solved=replace(result.solved, runtime_s=time.perf_counter() - started))
 
 
 def _check_reachable(problem: PlanProblem, places: list[Place], legs: Legs) -> None:

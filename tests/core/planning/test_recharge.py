@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from core.params import PRESETS, BatteryParams, ChargePoint, Depot, Stop, Weather
+from core.params import PRESETS, BatteryParams, ChargePoint, Depot, Stop, TimeWindow, Weather
 from core.planning.model import PlanProblem, PlanResult
 from core.planning.recharge import PARTIAL_CHARGE_MARGIN
 from core.planning.round import plan
@@ -174,3 +174,30 @@ def test_each_trip_is_put_in_its_own_best_order(charged, flat):
     kept = plan(as_found)
     assert kept.battery.feasible and len(kept.charges) == len(charged.charges)
     assert charged.distance_m <= kept.distance_m
+
+
+def windowed_day(charger: ChargePoint | None) -> PlanProblem:
+    """The summer day with every tenth stop wanting the morning, every tenth the afternoon."""
+    day = summer_day(charger)
+    morning = TimeWindow(start="07:00", end="12:00")
+    afternoon = TimeWindow(start="13:00", end="21:00")
+    windows = {1: [morning], 2: [afternoon]}
+    stops = [
+        s.model_copy(update={"time_windows": windows.get(k % 10, [])})
+        for k, s in enumerate(day.stops)
+    ]
+    return day.model_copy(update={"stops": stops, "time_limit_s": 5.0})
+
+
+def test_a_round_with_time_windows_charges_where_its_windows_leave_time():
+    """The order is the fleet search's (the windows first); the charges go where the forward
+    slack allows them, and no window is missed."""
+    assert not plan(windowed_day(None)).battery.feasible
+    day = windowed_day(ChargePoint(power_kw=22.0))
+    result = plan(day)
+    assert result.battery.feasible and result.battery.min_soc >= 0.1
+    assert result.charges and result.late_stops == []
+    served = {stop.id: stop.service_start for stop in result.stops}
+    for stop in day.stops:
+        for window in stop.time_windows:
+            assert window.start <= served[stop.id].time() <= window.end, stop.id
