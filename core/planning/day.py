@@ -8,6 +8,7 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +26,8 @@ from core.planning.timeline import ChargeVisit, windows_after
 from core.planning.verify import simulate_route
 from core.routing.geo import Legs
 from core.routing.roads import LegRoute, RoadRouter
-from core.routing.units import payload_units_up
+from core.routing.units import payload_units_down, payload_units_up
+from core.routing.vrp import trips_of
 
 
 @dataclass(frozen=True)
@@ -104,6 +106,16 @@ class FleetDay:
     @property
     def vans(self) -> range:
         return range(len(self.shifts))
+
+    def carries(self, v: int, route: Sequence[int]) -> bool:
+        """Whether van ``v`` carries ``route`` (stops, a 0 between them a return to reload):
+        no more trips than its ``max_trips``, none heavier than its payload."""
+        problem = self.shifts[v].problem
+        trips = trips_of(route)
+        payload = payload_units_down(problem.van.payload_kg)
+        return len(trips) <= problem.max_trips and all(
+            int(self.demand_g[trip].sum()) <= payload for trip in trips
+        )
 
     def clock(self, seconds: float) -> str:
         """A moment of the day as local HH:MM ("never" for infinity)."""

@@ -18,7 +18,6 @@ from core.planning.day import FleetDay
 from core.planning.model import UnassignedReason
 from core.planning.timeline import next_window
 from core.planning.verify import Failure
-from core.routing.units import payload_units_down
 
 
 @dataclass(frozen=True)
@@ -31,20 +30,24 @@ class Feasibility:
     budgets_j: Sequence[float | None]
 
     def violations(self, v: int, route: Sequence[int]) -> list[UnassignedReason]:
-        """The rules van ``v`` breaks on ``route`` (stops; the depot around it)."""
+        """The rules van ``v`` breaks on ``route`` (stops, a 0 between them a return to
+        reload; the depot around it)."""
         day = self.day
+        problem = day.shifts[v].problem
         broken: list[UnassignedReason] = []
-        payload = payload_units_down(day.shifts[v].problem.van.payload_kg)
-        if float(day.demand_g[list(route)].sum()) > payload:
+        if not day.carries(v, route):
             broken.append("capacity")
         budget = self.budgets_j[v]
         if budget is not None and day.estimates[v].route_energy_j(route) > budget:
             broken.append("battery")
         clock, end = day.shift_s[v]
-        for i, j in itertools.pairwise([0, *route, 0]):
+        for k, (i, j) in enumerate(itertools.pairwise([0, *route, 0])):
             clock += day.service_s[i] + self.travel_s[i, j]
-            if j == 0:
+            if j == 0 and k == len(route):
                 break
+            if j == 0:  # back to reload
+                clock += problem.reload_minutes * 60
+                continue
             window = next_window(clock, day.windows_s[j])
             if window is None:
                 broken.append("time_window")

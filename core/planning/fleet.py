@@ -46,6 +46,7 @@ from core.planning.model import (
     PlanProblem,
     PlanResult,
     RoundFields,
+    TripFields,
     Unassigned,
     check_places,
     fields_of,
@@ -178,6 +179,7 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
             start_time=vehicle.shift_start,
             time_limit_s=problem.time_limit_s,
             breaks=vehicle.breaks,
+            **fields_of(vehicle, TripFields),
             van=vehicle.van,
         )
         shifts.append(VanShift(vehicle.id, round_problem, ends[0], ends[1]))

@@ -27,6 +27,7 @@ from core.planning.recharge import Busy, visits_of
 from core.planning.scene import charge_points
 from core.planning.timeline import ChargeVisit
 from core.planning.verify import route_failure
+from core.routing.vrp import trips_tidied
 
 #: Places in each van's route a left-out stop is tried at, cheapest by distance first.
 POSITIONS_TRIED = 3
@@ -96,14 +97,15 @@ def serve_with_charging(
         if stop.reason != "battery" or time.perf_counter() >= deadline:
             continue
         node = place_of[stop.id]
-        for v, route in _candidates(day, routes, node, minimize_vehicles):
+        for insertion in _candidates(day, routes, node, minimize_vehicles):
             if time.perf_counter() >= deadline:
                 break
+            v = insertion.v
             shift = day.shifts[v]
-            order, charges = _with_stop(shift.problem, places, results.get(v), route, node)
+            order, charges = _with_stop(shift.problem, places, results.get(v), insertion)
             result = day.charged(v, order, charges, bookings.busy(shift.id))
             if route_failure(shift.id, shift.problem, places, result, shift.end, True) is None:
-                routes[v], results[v] = route, result
+                routes[v], results[v] = insertion.route, result
                 bookings.book(shift.id, place_of, result)
                 served.add(node)
                 break
@@ -121,32 +123,54 @@ def serve_with_charging(
     return routes, results, left
 
 
+@dataclass(frozen=True)
+class _Insertion:
+    """Van ``v``'s ``route`` (stops, a 0 a return to reload) with ``placed`` — the stop, and
+    a return to reload before or after it — at position ``k`` of its route before."""
+
+    v: int
+    route: list[int]
+    k: int
+    placed: list[int]
+
+
 def _with_stop(
-    problem: PlanProblem,
-    places: list[Place],
-    driven: PlanResult | None,
-    route: list[int],
-    node: int,
+    problem: PlanProblem, places: list[Place], driven: PlanResult | None, insertion: _Insertion
 ) -> tuple[list[int], dict[int, ChargeVisit]]:
-    """The order a van drives ``route`` (its stops, ``node`` among them) in, keeping the
-    chargers and charges of what it drove before (``driven``, without ``node``)."""
+    """The order the van drives its longer route in, keeping the chargers and charges of
+    what it drove before (``driven``)."""
     if driven is None:
-        return [0, *route, 0], {}
+        return [0, *insertion.route, 0], {}
     order, charges = visits_of(problem, places, driven)
-    k = route.index(node)
-    after = 0 if k == 0 else order.index(route[k - 1])
-    order = [*order[: after + 1], node, *order[after + 1 :]]
-    return order, {q + (q > after): c for q, c in charges.items()}
+    after = 0  # where the route's place before the insertion is in the order
+    for place in insertion.route[: insertion.k]:
+        after = order.index(place, after + 1)
+    order = [*order[: after + 1], *insertion.placed, *order[after + 1 :]]
+    shift = len(insertion.placed)
+    return order, {q + shift * (q > after): c for q, c in charges.items()}
+
+
+def _placings(route: list[int], node: int) -> list[tuple[int, list[int]]]:
+    """Where and how ``node`` may join ``route``: at each position, alone, or with a return
+    to reload before or after it (when a trip would get too heavy for the van); never a
+    return at an end or beside another."""
+    out = []
+    for k in range(len(route) + 1):
+        for placed in ([node], [0, node], [node, 0]):
+            longer = [*route[:k], *placed, *route[k:]]
+            if trips_tidied(longer) == longer:
+                out.append((k, placed))
+    return out
 
 
 def _candidates(
     day: FleetDay, routes: list[list[int]], node: int, minimize_vehicles: bool
-) -> list[tuple[int, list[int]]]:
-    """Each van's route with ``node`` at its cheapest places on the objective, and ``node``
-    alone for a van not driving, best first: fewer charges by the estimates (the energy
-    beyond the battery, in batteries), then what the objective gains; the vans not driving
-    after the others when the fleet is to be small."""
-    options: list[tuple[bool, int, float, int, list[int]]] = []
+) -> list[_Insertion]:
+    """Each van's route with ``node`` at its cheapest places on the objective (the van
+    carrying every trip), and ``node`` alone for a van not driving, best first: fewer charges
+    by the estimates (the energy beyond the battery, in batteries), then what the objective
+    gains; the vans not driving after the others when the fleet is to be small."""
+    options: list[tuple[bool, int, float, int, _Insertion]] = []
     idle: set[tuple[int, tuple[float, float]]] = set()
     for v, route in enumerate(routes):
         estimates = day.estimates[v]
@@ -156,13 +180,15 @@ def _candidates(
         if not route:
             idle.add(kind)
         before = estimates.route_cost(route)
-        tried = sorted(
-            (estimates.route_cost(longer) - before, longer)
-            for longer in ([*route[:k], node, *route[k:]] for k in range(len(route) + 1))
-        )
-        for extra, longer in tried[:POSITIONS_TRIED]:
-            beyond = estimates.route_energy_j(longer) / max(estimates.budget_j, 1.0) - 1.0
-            charges = max(math.ceil(beyond), 0)
-            options.append((minimize_vehicles and not route, charges, extra, v, longer))
-    options.sort(key=lambda o: o[:3])
-    return [(v, route) for *_, v, route in options]
+        tried: list[tuple[float, int, _Insertion]] = []
+        for k, placed in _placings(route, node):
+            longer = [*route[:k], *placed, *route[k:]]
+            if day.carries(v, longer):
+                extra = estimates.route_cost(longer) - before
+                tried.append((extra, len(tried), _Insertion(v, longer, k, placed)))
+        for extra, _, insertion in sorted(tried)[:POSITIONS_TRIED]:
+            energy_j = estimates.route_energy_j(insertion.route)
+            charges = max(math.ceil(energy_j / max(estimates.budget_j, 1.0) - 1.0), 0)
+            options.append((minimize_vehicles and not route, charges, extra, v, insertion))
+    options.sort(key=lambda o: o[:4])
+    return [insertion for *_, insertion in options]

@@ -185,7 +185,25 @@ class StartState(Params):
     )
 
 
-class PlanFields(RoundFields):
+class TripFields(Params):
+    """How often a van may come back to the depot to reload, and how long that takes."""
+
+    max_trips: int = Field(
+        1,
+        ge=1,
+        le=MAX_TRIPS,
+        description="Most trips from the depot (1–20): with more than 1, the van comes back to "
+        "reload (its payload back to payload_kg) when its stops take more than it carries; "
+        "every return to the depot reloads then, one to charge too (the van stands the longer "
+        "of the two), and returns only to charge do not count. In /v1/plans: rounds without "
+        "time windows and without start_state.",
+    )
+    reload_minutes: float = Field(
+        15.0, ge=0, le=MAX_RELOAD_MINUTES, description="Minutes to reload at the depot, 0–240."
+    )
+
+
+class PlanFields(RoundFields, TripFields):
     """One round: when it leaves, and whether its order is the client's."""
 
     start_time: ClockTime = clock_field(
@@ -196,18 +214,6 @@ class PlanFields(RoundFields):
     keep_order: bool = Field(False, description="Drive the stops in the given order.")
     time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT_S)
     breaks: Breaks = breaks_field("none")
-    max_trips: int = Field(
-        1,
-        ge=1,
-        le=MAX_TRIPS,
-        description="Most trips from the depot (1–20): with more than 1, a round whose stops "
-        "take more than payload_kg comes back to reload (its payload back to payload_kg) "
-        "before the stop it could not carry. Returns to charge do not count. Rounds without "
-        "time windows and without start_state.",
-    )
-    reload_minutes: float = Field(
-        15.0, ge=0, le=MAX_RELOAD_MINUTES, description="Minutes to reload at the depot, 0–240."
-    )
     start_state: StartState | None = Field(
         None,
         description="Plan the rest of a day from where the van is (its position, time, charge, "
@@ -230,8 +236,8 @@ def shift_in_order(start: dt.time | None, end: dt.time) -> dt.time:
     return end
 
 
-class ShiftFields(Params):
-    """One van of a fleet without its parameters: its id and its driver's shift."""
+class ShiftFields(TripFields):
+    """One van of a fleet without its parameters: its id, its driver's shift and its trips."""
 
     id: str = Field(
         ..., min_length=1, max_length=64, description="Identifier of the van, unique in the fleet."

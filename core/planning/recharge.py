@@ -110,7 +110,8 @@ def with_charges(
     charged = _charged_until_it_holds(day, points, charged)
     result = charged.result
     reloads = any(  # the tour again would lose the returns to reload
-        place == 0 and q not in charged.charges for q, place in enumerate(charged.order[1:-1], 1)
+        place == 0 and (q not in charged.charges or charged.charges[q].reloads)
+        for q, place in enumerate(charged.order[1:-1], 1)
     )
     if orders is not None and charged.charges and result.battery.feasible and not reloads:
         result = _better_orders(day, points, charged, orders)
@@ -141,11 +142,14 @@ def _charged(
     reserve = day.problem.van.battery.min_soc
     for option in _charge_options(day, points, order, charges, result, stretch)[:OPTIONS_TRIED]:
         cut = option.cut
-        tried = [*order[: cut + 1], option.place, *order[cut + 1 :]]
-        visits = {q + (q > cut): c for q, c in charges.items()} | {cut + 1: option.visit}
+        if option.inserted:
+            tried = [*order[: cut + 1], option.place, *order[cut + 1 :]]
+            visits = {q + (q > cut): c for q, c in charges.items()} | {cut + 1: option.visit}
+        else:  # at the depot, where the van reloads
+            tried, visits = order, charges | {cut: option.visit}
         charged = _refitted(day, tried, visits)  # filled, then every charge fitted
         simulated = charged.result
-        reached = simulated.legs[cut].soc_end >= reserve
+        reached = simulated.legs[cut if option.inserted else cut - 1].soc_end >= reserve
         if reached and simulated.battery.margin_kwh > result.battery.margin_kwh:
             return charged.order, charged.charges, simulated
     return None
@@ -256,12 +260,19 @@ def visits_of(
         order[0] = index[result.tour[0]]
     points = charge_points(problem)
     by_arrival = {charge.arrive: charge for charge in result.charges}
+    reloaded = {reload.arrive for reload in result.reloads}
     visits = {}
     for q in range(1, len(order) - 1):
-        charge = by_arrival.get(result.legs[q - 1].arrive)
+        came = result.legs[q - 1].arrive
+        charge = by_arrival.get(came)
         if order[q] in points and charge is not None:
             point = points[order[q]]
-            visits[q] = ChargeVisit(point.plug_minutes * 60, charge.minutes * 60, point.power_kw)
+            visits[q] = ChargeVisit(
+                point.plug_minutes * 60,
+                charge.minutes * 60,
+                point.power_kw,
+                reloads=order[q] == 0 and came in reloaded,
+            )
     return order, visits
 
 
@@ -349,13 +360,15 @@ def _first_short_stretch(
 
 @dataclass(frozen=True)
 class _Option:
-    """Charging at place ``place`` after position ``cut`` of the order: the time it adds [s]
-    and the visit (a full charge, fitted after)."""
+    """Charging at place ``place`` after position ``cut`` of the order (``inserted``), or at
+    position ``cut`` itself (the depot, where the van comes back to reload): the time it adds
+    [s] and the visit (a full charge, fitted after)."""
 
     cut: int
     place: int
     added_s: float
     visit: ChargeVisit
+    inserted: bool = True
 
 
 def _charge_options(
@@ -390,6 +403,10 @@ def _charge_options(
         here, onward = order[p], order[p + 1]
         if p in charges or (p == 0 and here == 0):  # charged here already, or the depot
             continue
+        if here == 0 and 0 in points:  # back to reload: charge meanwhile
+            at = _reload_charge(day, points[0], p, result, _energy_j(result, p, stretch[1]))
+            if at is not None and at.added_s <= slack[p]:
+                options.append(at)
         leaving = result.legs[p].soc_start
         left_s = (result.legs[p].depart - day.start).total_seconds()
         rest = _energy_j(result, p + 1, stretch[1]) / capacity_j
@@ -425,6 +442,32 @@ def _charge_options(
             visit = ChargeVisit(plug_s, curve.time_s(plugged, 1.0), point.power_kw, open_s)
             options.append(_Option(p, place, added_s, visit))
     return sorted(options, key=lambda o: (o.added_s, -o.cut))
+
+
+def _reload_charge(
+    day: _Round, point: ChargePoint, p: int, result: PlanResult, rest_j: float
+) -> _Option | None:
+    """Charging at the depot's ``point`` while the van reloads at position ``p``: the time
+    beyond the reload it adds (with any wait for a free point); None when the van comes back
+    below its reserve or no point is free for the charge."""
+    arriving = result.legs[p - 1].soc_end
+    reserve = day.problem.van.battery.min_soc
+    come_s = (result.legs[p - 1].arrive - day.start).total_seconds()
+    open_s = day.open_s(0, point)
+    hours = next_window(come_s, open_s)
+    if arriving < reserve or hours is None:
+        return None
+    capacity_j = result.battery.usable_capacity_kwh * JOULES_PER_KWH
+    needed = min(reserve + rest_j / capacity_j + PARTIAL_CHARGE_MARGIN, 1.0)
+    curve = day.curve(point, result)
+    plug_s = point.plug_minutes * 60
+    wait_s = max(hours[0] - come_s, 0.0)
+    standing_s = wait_s + plug_s + curve.time_s(arriving, needed)
+    if come_s + standing_s > hours[1]:
+        return None  # another van takes the point before the charge is done
+    added_s = max(standing_s - day.problem.reload_minutes * 60, 0.0)
+    visit = ChargeVisit(plug_s, curve.time_s(arriving, 1.0), point.power_kw, open_s, True)
+    return _Option(p, 0, added_s, visit, inserted=False)
 
 
 def _slack_s(day: _Round, order: list[int], result: PlanResult) -> list[float]:
@@ -499,8 +542,9 @@ def _without_idle(
     order: list[int], charges: dict[int, ChargeVisit]
 ) -> tuple[list[int], dict[int, ChargeVisit]]:
     """``order`` and ``charges`` without the charger visits that have nothing to charge (an
-    earlier charge covers their stretch too)."""
+    earlier charge covers their stretch too); a return to reload stays, without its charge."""
     idle = {q for q, visit in charges.items() if visit.charge_s <= 0}
-    kept = [place for q, place in enumerate(order) if q not in idle]
-    moved = {q - sum(i < q for i in idle): visit for q, visit in charges.items() if q not in idle}
+    gone = {q for q in idle if not charges[q].reloads}
+    kept = [place for q, place in enumerate(order) if q not in gone]
+    moved = {q - sum(i < q for i in gone): visit for q, visit in charges.items() if q not in idle}
     return kept, moved

@@ -13,24 +13,27 @@ from core.planning.estimates import VanEstimates
 from core.planning.feasibility import Feasibility
 from core.planning.model import PlanResult
 from core.planning.verify import Failure
+from core.routing.vrp import trips_tidied
 
 
 def fitting(rules: Feasibility, v: int, route: list[int]) -> list[int]:
     """The route less its last stops until the estimates accept it."""
     route = list(route)
     while route and rules.violations(v, route):
-        route.pop()
+        route = trips_tidied(route[:-1])
     return route
 
 
 def costliest(estimates: VanEstimates, route: list[int]) -> int:
-    """The stop whose removal saves the most estimated energy."""
+    """The stop whose removal saves the most estimated energy (not a return to reload)."""
     energy = estimates.energy_j
     order = [0, *route, 0]
     savings = [
         energy[order[k - 1], order[k]]
         + energy[order[k], order[k + 1]]
         - energy[order[k - 1], order[k + 1]]
+        if order[k]
+        else -np.inf
         for k in range(1, len(order) - 1)
     ]
     return route[int(np.argmax(savings))]
@@ -62,7 +65,7 @@ def repair(
     current: Failure | None = failure
     while route and current is not None:
         node = current.node if current.node is not None else costliest(estimates, route)
-        route.remove(node)
+        route = trips_tidied([n for n in route if n != node])
         removed[node] = current
         if not route:
             return Repaired(route, None, removed)

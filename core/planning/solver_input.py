@@ -40,6 +40,8 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
                 shift_s=(math.ceil(start_s), math.floor(end_s)),
                 fixed_cost=fixed + v,
                 wait_cost_per_s=estimates.wait_cost_per_s,
+                max_reloads=shift.problem.max_trips - 1,
+                reload_s=math.ceil(shift.problem.reload_minutes * 60),
             )
         )
     never = [(day.horizon_s + 1, day.horizon_s + 1)]

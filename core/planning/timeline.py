@@ -129,12 +129,14 @@ class ChargeVisit:
     """A stop at a charger between stops (the depot's or one on the way): the minutes to plug
     in and out and the charge itself [s], at a point of ``power_kw``, open during ``open_s``
     (seconds after the departure; empty: always). The van waits for the opening; the charge
-    ends at the closing at the latest."""
+    ends at the closing at the latest. ``reloads``: at the depot, where the van comes back to
+    reload as well (it stands the longer of the two)."""
 
     plug_s: float
     charge_s: float
     power_kw: float
     open_s: Windows = ()
+    reloads: bool = False
 
 
 @dataclass(frozen=True)
@@ -392,10 +394,13 @@ class _Builder:
         self.payload_kg = max(self.payload_kg - stop.delivery_kg, 0.0)
         self.stand(dwell, self.payload_kg)
 
-    def charge(self, position: int, visit: ChargeVisit) -> None:
+    def charge(
+        self, position: int, visit: ChargeVisit, reload: tuple[float, float] | None = None
+    ) -> None:
         """Stand at a charger (place ``position`` of the order): wait for it to open, plug in,
         charge for ``visit.charge_s`` (until it closes at the latest), unplug. A charger
-        closed for the rest of the day charges nothing."""
+        closed for the rest of the day charges nothing. ``reload`` (its duration [s] and the
+        payload [kg]): the van is reloaded meanwhile, and stands at least that long."""
         plug = math.ceil(visit.plug_s / 2 / PLAN_DT_S)
         arrival = self.clock
         hours = next_window(arrival * PLAN_DT_S, visit.open_s)
@@ -422,6 +427,10 @@ class _Builder:
                 )
             )
         self.stand(charge + plug, self.payload_kg)
+        if reload is not None:
+            duration_s, self.payload_kg = reload
+            self.reloaded_at.append(position)
+            self.stand_parked(math.ceil(duration_s / PLAN_DT_S) - (self.clock - arrival))
         if self.rest.eu_561 and (self.clock - arrival) * PLAN_DT_S >= EU_BREAK_S:
             self.counts_as_break(arrival, "eu-561")  # charged (or waited) during the break
 
@@ -497,7 +506,11 @@ def build_timeline(
         if 0 < j <= len(problem.stops):
             day.serve(j, problem.stops[j - 1], windows_s[j] if windows_s is not None else ())
         elif charges is not None and k + 1 in charges:
-            day.charge(k + 1, charges[k + 1])
+            visit = charges[k + 1]  # reloaded while it charges, when it came back for both
+            reload = (
+                (problem.reload_minutes * 60, problem.van.payload_kg) if visit.reloads else None
+            )
+            day.charge(k + 1, visit, reload)
         elif j == 0 and k + 2 < len(order):  # back at the depot between stops, not to charge
             day.reload(k + 1, problem.reload_minutes * 60, problem.van.payload_kg)
         else:

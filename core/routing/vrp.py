@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import itertools
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,6 +64,11 @@ class VehicleSpec:
         Cost of using the van at all (fewer vans first when large).
     wait_cost_per_s
         Cost of each second spent waiting for a window (the objective's unit per second).
+    max_reloads
+        How often the van may come back to the depot to reload between stops (a 0 in its
+        route); its payload is then back to ``payload_capacity_g``.
+    reload_s
+        How long a reload takes [s].
     """
 
     arc_cost: IntMatrix
@@ -72,6 +78,8 @@ class VehicleSpec:
     shift_s: tuple[int, int]
     fixed_cost: int = 0
     wait_cost_per_s: int = 0
+    max_reloads: int = 0
+    reload_s: int = 0
 
 
 @dataclass(frozen=True)
@@ -107,7 +115,8 @@ class RoutingInput:
 
 @dataclass(frozen=True)
 class RoutingOutcome:
-    """Stops of each van in driving order (no depot); a stop in no route is left out."""
+    """Stops of each van in driving order (no depot around them; a 0 between stops is a
+    return to reload); a stop in no route is left out."""
 
     routes: list[list[int]]
 
@@ -127,14 +136,19 @@ def solve_routes(
         Routes to start from (stops per van); ignored when they break a constraint.
     """
     deadline = time.perf_counter() + time_limit_s
-    waits_cost = any(v.wait_cost_per_s for v in problem.vehicles)
+    # OR-Tools' model has no reloads: routes that reload are PyVRP's, trimmed to the budget.
+    reloads = any(v.max_reloads for v in problem.vehicles)
+    waits_cost = any(v.wait_cost_per_s for v in problem.vehicles) and not reloads
     share = WAIT_POLISH_SHARE if waits_cost else 0.0
     found = _pyvrp_routes(problem, deadline - time_limit_s * share, initial)
     if found is not None and not waits_cost and not _over_energy(problem, found):
         return RoutingOutcome(found)
     if found is None:
-        return _ortools_routes(problem, deadline, initial)
+        one_trip = None if initial is None else [[n for n in r if n] for r in initial]
+        return _ortools_routes(problem, deadline, one_trip)
     fitting = [_within_energy(problem, v, r) for v, r in enumerate(found)]
+    if reloads:
+        return RoutingOutcome(fitting)
     polished = _ortools_routes(problem, deadline, fitting)
     # OR-Tools may find less in what is left of the budget (or reject the start and begin
     # afresh): PyVRP's routes, trimmed, hold.
@@ -173,6 +187,28 @@ def _within_energy(problem: RoutingInput, v: int, route: list[int]) -> list[int]
         and problem.vehicles[v].energy is not None
     ):
         kept.pop()
+    return trips_tidied(kept)
+
+
+def trips_of(route: Sequence[int]) -> list[list[int]]:
+    """The stops of each trip of ``route`` (split at its returns to reload)."""
+    trips: list[list[int]] = [[]]
+    for node in route:
+        if node:
+            trips[-1].append(node)
+        else:
+            trips.append([])
+    return [trip for trip in trips if trip]
+
+
+def trips_tidied(route: list[int]) -> list[int]:
+    """``route`` without returns to reload that have no stop after them (or before)."""
+    kept: list[int] = []
+    for node in route:
+        if node or (kept and kept[-1]):
+            kept.append(node)
+    while kept and not kept[-1]:
+        kept.pop()
     return kept
 
 
@@ -187,7 +223,13 @@ class _PyvrpModel:
 
 
 def _kind(vehicle: VehicleSpec) -> tuple[object, ...]:
-    return (id(vehicle.arc_cost), vehicle.payload_capacity_g, vehicle.shift_s)
+    return (
+        id(vehicle.arc_cost),
+        vehicle.payload_capacity_g,
+        vehicle.shift_s,
+        vehicle.max_reloads,
+        vehicle.reload_s,
+    )
 
 
 def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
@@ -236,6 +278,17 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
     matrices: dict[int, int] = {}
     distance_matrices: list[IntMatrix] = []
     vehicle_types = []
+    # the depot to start and end at, then one at the same place per reload time (its service)
+    depots = [pyvrp.Depot(location=0, tw_early=0, tw_late=horizon)]
+    reload_depot: dict[int, int] = {}
+    for vehicle in problem.vehicles:
+        if vehicle.max_reloads and vehicle.reload_s not in reload_depot:
+            reload_depot[vehicle.reload_s] = len(depots)
+            depots.append(
+                pyvrp.Depot(
+                    location=0, tw_early=0, tw_late=horizon, service_duration=vehicle.reload_s
+                )
+            )
     for vans in kinds.values():
         vehicle = problem.vehicles[vans[0]]
         key = id(vehicle.arc_cost)
@@ -251,13 +304,15 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
                 tw_early=first,
                 tw_late=last,
                 profile=matrices[key],
+                reload_depots=[reload_depot[vehicle.reload_s]] if vehicle.max_reloads else [],
+                max_reloads=vehicle.max_reloads,
             )
         )
     travel = np.asarray(problem.travel_s, dtype=np.int64)
     data = pyvrp.ProblemData(
         locations,
         clients,
-        [pyvrp.Depot(location=0, tw_early=0, tw_late=horizon)],
+        depots,
         vehicle_types,
         distance_matrices,  # type: ignore[arg-type]  # PyVRP's stubs name ndarray[int]
         [travel] * len(distance_matrices),  # type: ignore[list-item]
@@ -290,7 +345,8 @@ def _pyvrp_routes(
         kind = route.vehicle_type()
         van = model.type_vans[kind][taken[kind]]
         taken[kind] += 1
-        routes[van] = [model.client_node[a.idx] for a in route.schedule() if a.is_client()]
+        visits = route.schedule()[1:-1]
+        routes[van] = [model.client_node[a.idx] if a.is_client() else 0 for a in visits]
     return routes
 
 
@@ -299,15 +355,19 @@ def _pyvrp_start(model: _PyvrpModel, initial: list[list[int]] | None) -> pyvrp.S
     if initial is None:
         return None
     van_type = {van: kind for kind, vans in enumerate(model.type_vans) for van in vans}
-    routes = [
-        pyvrp.Route(
-            model.data,
-            [model.node_clients[node][0] for node in route if node in model.node_clients],
-            van_type[v],
-        )
-        for v, route in enumerate(initial)
-        if route
-    ]
+    routes = []
+    for v, route in enumerate(initial):
+        kind = van_type[v]
+        reload = model.data.vehicle_type(kind).reload_depots
+        nodes = [n for n in route if n in model.node_clients or (not n and reload)]
+        activities = [
+            pyvrp.Activity(pyvrp.ActivityType.CLIENT, model.node_clients[node][0])
+            if node
+            else pyvrp.Activity(pyvrp.ActivityType.DEPOT, reload[0])
+            for node in trips_tidied(nodes)
+        ]
+        if activities:
+            routes.append(pyvrp.Route(model.data, activities, kind))
     return pyvrp.Solution(model.data, routes)
 
 

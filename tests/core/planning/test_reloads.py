@@ -9,7 +9,9 @@ import datetime as dt
 import pytest
 
 from core.exceptions import InvalidParameterError, InvalidStopsError
-from core.params import TimeWindow
+from core.params import ChargePoint, TimeWindow
+from core.planning.fleet import plan_fleet
+from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
 from core.planning.round import plan
 from tests.core.planning.test_recharge import summer_day
 
@@ -89,3 +91,70 @@ def test_bad_trips_are_refused(fields, field):
     with pytest.raises(InvalidParameterError) as caught:
         type(heavy())(**(heavy().model_dump() | fields))
     assert caught.value.field == field
+
+
+def fleet_of_trips(max_trips: int, charger=None, capacity_kwh: float = 40.0) -> FleetProblem:
+    """30 of the summer day's stops at 25 kg (750 kg) for one 400 kg van of the fleet."""
+    day = summer_day(charger)
+    stops = [stop.model_copy(update={"delivery_kg": 25.0}) for stop in day.stops[:30]]
+    battery = day.van.battery.model_copy(update={"usable_capacity_kwh": capacity_kwh})
+    van = day.van.model_copy(update={"battery": battery})
+    vehicle = FleetVehicle(
+        id="van",
+        shift_start="07:00",
+        shift_end="20:00",
+        max_trips=max_trips,
+        reload_minutes=20,
+        van=van,
+    )
+    return FleetProblem(
+        **fields_of(day, RoundFields) | {"stops": stops}, vehicles=[vehicle], time_limit_s=8.0
+    )
+
+
+def trip_loads(result) -> list[float]:
+    """What each trip delivers, by the stops between the depot visits that reload."""
+    reloaded = {reload.arrive for reload in result.reloads}
+    delivered = {stop.id: 25.0 for stop in result.stops}
+    loads = [0.0]
+    for leg in result.legs[:-1]:
+        if leg.to_id == "depot" and leg.arrive in reloaded:
+            loads.append(0.0)
+        loads[-1] += delivered.get(leg.to_id, 0.0)
+    return loads
+
+
+def test_a_fleet_van_comes_back_to_reload_when_its_trips_allow():
+    one = plan_fleet(fleet_of_trips(1, capacity_kwh=90.0))
+    # one trip: 16 stops are 400 kg, the other 14 stay for capacity
+    assert sorted(u.reason for u in one.unassigned) == ["capacity"] * 14
+    two = plan_fleet(fleet_of_trips(2, capacity_kwh=90.0))
+    assert two.unassigned == []
+    (route,) = two.routes
+    (reload,) = route.plan.reloads
+    assert (reload.depart - reload.arrive).total_seconds() == pytest.approx(20 * 60, abs=1)
+    loads = trip_loads(route.plan)
+    assert len(loads) == 2 and sum(loads) == 750 and max(loads) <= 400
+    # the second trip leaves with 400 kg again
+    first_after = route.plan.tour[route.plan.tour.index("depot", 1) + 1]
+    after = next(s for s in route.plan.stops if s.id == first_after)
+    assert after.payload_after_kg == 400 - 25
+    assert route.plan.battery.feasible
+
+
+def test_a_fleet_van_charges_at_the_depot_while_it_reloads():
+    """On 40 kWh the day takes more than the battery: with the depot's 22 kW charger the
+    van charges while it reloads, one stop at the depot for both."""
+    flat = plan_fleet(fleet_of_trips(2))
+    assert any(u.reason == "battery" for u in flat.unassigned)
+    charged = plan_fleet(fleet_of_trips(2, ChargePoint(power_kw=22.0)))
+    assert charged.unassigned == []
+    (route,) = charged.routes
+    plan_ = route.plan
+    assert plan_.battery.feasible and plan_.battery.min_soc >= 0.1
+    (reload,) = plan_.reloads
+    both = next(c for c in plan_.charges if c.arrive == reload.arrive)
+    assert both.depart == reload.depart
+    standing_s = (both.depart - both.arrive).total_seconds()
+    assert standing_s >= max(20 * 60, both.minutes * 60 + 120) - 1
+    assert max(trip_loads(plan_)) <= 400
