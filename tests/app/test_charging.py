@@ -231,3 +231,25 @@ def test_a_round_heavier_than_the_van_reloads_over_http(client):
         refused = client.post("/v1/plans", json=body | bad)
         assert refused.status_code == 422
         assert refused.json()["errors"][0]["field"] == next(iter(bad))
+
+
+def test_a_fleet_van_reloads_over_http_and_bad_trips_name_the_van(client):
+    """One van of 100 kg for the example's stops at 40 kg each: it comes back to reload."""
+    stops = [s | {"delivery_kg": 40} for s in FLEET_PLAN_EXAMPLE["stops"]]
+    (van, _) = FLEET_PLAN_EXAMPLE["vehicles"]
+    small = van | {"payload_kg": 100, "max_trips": 6, "reload_minutes": 5, "shift_end": "18:00"}
+    body = FLEET_PLAN_EXAMPLE | {"stops": stops, "vehicles": [small], "time_limit_s": 3}
+    response = client.post("/v1/fleet-plans", json=body)
+    assert response.status_code == 200
+    answer = response.json()
+    (route,) = answer["routes"]
+    served = len(route["stops"])
+    assert served > 2 and len(route["reloads"]) >= (served * 40 - 1) // 100
+    assert all(r["payload_kg"] == 100 for r in route["reloads"])
+    # each trip carries two stops of 40 kg: 60 kg left after the first, 20 after the second
+    # (an overloaded van would show 0: the payload does not go below it)
+    assert {stop["payload_after_kg"] for stop in route["stops"]} <= {60, 20}
+    for bad in ({"max_trips": 0}, {"max_trips": 21}, {"reload_minutes": -1}):
+        refused = client.post("/v1/fleet-plans", json=body | {"vehicles": [small | bad]})
+        assert refused.status_code == 422
+        assert refused.json()["errors"][0]["field"] == f"vehicles[0].{next(iter(bad))}"
