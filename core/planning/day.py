@@ -9,7 +9,7 @@ import datetime as dt
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,6 +22,7 @@ from core.planning.estimates import VanEstimates, van_estimates
 from core.planning.model import MAX_ROUND_S, PlanProblem, PlanResult, Solved, place_field
 from core.planning.recharge import Busy, with_charges
 from core.planning.scene import Scene
+from core.planning.start_state import start_payload_kg
 from core.planning.timeline import ChargeVisit, windows_after
 from core.planning.verify import simulate_route
 from core.routing.geo import Legs
@@ -82,6 +83,9 @@ class FleetDay:
         Places with no road from or to the depot.
     estimates
         Each van's estimates (vans of one kind share them).
+    starts
+        The place each van sets off from: the depot (0), or its position when it is under way
+        (a place after the stops).
     """
 
     scene: Scene
@@ -97,11 +101,22 @@ class FleetDay:
     duration_s: FloatArray
     unreachable: frozenset[int]
     estimates: list[VanEstimates]
+    starts: list[int]
 
     @property
     def n(self) -> int:
-        """The solver's places: the depot and the stops (the chargers come after them)."""
+        """The solver's places: the depot, the stops and the positions of the vans under way
+        (the chargers come after them)."""
         return len(self.finite)
+
+    @property
+    def stop_nodes(self) -> range:
+        """The stops' places."""
+        return range(1, len(self.shifts[0].problem.stops) + 1)
+
+    def order(self, v: int, route: Sequence[int]) -> list[int]:
+        """The places van ``v`` drives for ``route``: from where it sets off, back to the depot."""
+        return [self.starts[v], *route, 0]
 
     @property
     def vans(self) -> range:
@@ -113,8 +128,12 @@ class FleetDay:
         problem = self.shifts[v].problem
         trips = trips_of(route)
         payload = payload_units_down(problem.van.payload_kg)
+        if route[:1] == [0]:  # under way, back to reload first
+            trips = [[], *trips]
+        first = payload_units_down(start_payload_kg(problem))  # under way: what is aboard
         return len(trips) <= problem.max_trips and all(
-            int(self.demand_g[trip].sum()) <= payload for trip in trips
+            int(self.demand_g[trip].sum()) <= (first if k == 0 else payload)
+            for k, trip in enumerate(trips)
         )
 
     def clock(self, seconds: float) -> str:
@@ -140,7 +159,7 @@ class FleetDay:
         ``charges`` fitted again and more where its battery would not last
         (:func:`core.planning.recharge.with_charges`): its windows and its shift kept, the
         charge points free when ``busy`` says other vans do not take them all."""
-        stops = [place for place in order[1:-1] if 0 < place < self.n]
+        stops = [place for place in order[1:-1] if place in self.stop_nodes]
         problem, scene, _, start, solved = self._round(v, stops)
         windows, latest_s = self._limits(v)
         return with_charges(
@@ -162,7 +181,7 @@ class FleetDay:
     ) -> tuple[PlanProblem, Scene, list[int], dt.datetime, Solved]:
         shift = self.shifts[v]
         solved = Solved("feasible", self.estimates[v].route_cost(route), 0.0)
-        return shift.problem, self.scene, [0, *route, 0], shift.start, solved
+        return shift.problem, self.scene, self.order(v, route), shift.start, solved
 
     def _roads(self, order: list[int]) -> list[LegRoute] | None:
         if self.router is None or self.scene.legs.source != "osrm":
@@ -179,9 +198,18 @@ class FleetDay:
         return windows, latest_s
 
 
-def fleet_day(shifts: list[VanShift], scene: Scene, router: RoadRouter | None) -> FleetDay:
-    """The day of ``shifts`` on ``scene``: the shared facts and each kind of van's estimates."""
+def fleet_day(
+    shifts: list[VanShift],
+    scene: Scene,
+    router: RoadRouter | None,
+    starts: Sequence[int] | None = None,
+) -> FleetDay:
+    """The day of ``shifts`` on ``scene``: the shared facts and each kind of van's estimates.
+    ``starts``: where each van sets off (its position's place, after the stops, when under
+    way; by default the depot)."""
     base = shifts[0].problem
+    starts = list(starts or [0] * len(shifts))
+    solver_places = max([len(base.stops) + 1, *(k + 1 for k in starts)])
     reference = min(shift.start for shift in shifts)
     origin = reference.timestamp()
     shift_s = [
@@ -191,19 +219,22 @@ def fleet_day(shifts: list[VanShift], scene: Scene, router: RoadRouter | None) -
         )
         for shift in shifts
     ]
-    legs = scene.legs.first(len(base.stops) + 1)  # the solver's places: not the chargers
+    legs = scene.legs.first(solver_places)  # not the chargers
     finite = np.isfinite(legs.duration_s) & np.isfinite(legs.distance_m)
-    service_s = np.array([0.0] + [math.ceil(s.service_time_s) for s in base.stops])
+    service_s = np.zeros(solver_places)
+    service_s[1 : len(base.stops) + 1] = [math.ceil(s.service_time_s) for s in base.stops]
+    demand_g = np.zeros(solver_places, dtype=np.int64)
+    demand_g[1 : len(base.stops) + 1] = payload_units_up([s.delivery_kg for s in base.stops])
     solver_legs = _long_where_no_road(legs, finite)
     kinds: dict[str, VanEstimates] = {}
     estimates = []
-    for shift in shifts:
+    for shift, start in zip(shifts, starts, strict=True):
         key = f"{shift.problem.van.model_dump_json()}@{shift.start.isoformat()}"
         if key not in kinds:
             kinds[key] = van_estimates(
                 shift.problem, solver_legs, shift.start, base.stops, service_s
             )
-        estimates.append(kinds[key])
+        estimates.append(kinds[key] if not start else replace(kinds[key], start=start))
     return FleetDay(
         scene=scene,
         router=router,
@@ -211,13 +242,15 @@ def fleet_day(shifts: list[VanShift], scene: Scene, router: RoadRouter | None) -
         reference=reference,
         shift_s=shift_s,
         horizon_s=math.floor(max(end for _, end in shift_s)),
-        windows_s=windows_after(base.stops, base.date, reference),
+        windows_s=windows_after(base.stops, base.date, reference)
+        + [[] for _ in range(solver_places - len(base.stops) - 1)],
         service_s=service_s,
-        demand_g=np.concatenate(([0], payload_units_up([s.delivery_kg for s in base.stops]))),
+        demand_g=demand_g,
         finite=finite,
         duration_s=np.where(finite, legs.duration_s, 0.0),
         unreachable=frozenset(legs.unreachable()),
         estimates=estimates,
+        starts=starts,
     )
 
 

@@ -123,6 +123,8 @@ class VanEstimates:
     wait_cost_per_s
         The objective's cost of a second spent waiting for a window (integer units per s):
         time, and energy, for the van stands with its loads on.
+    start
+        The place the van sets off from: the depot (0), or its position when under way.
     """
 
     arc_cost: NDArray[np.int64]
@@ -131,16 +133,18 @@ class VanEstimates:
     energy_j: FloatArray
     budget_j: float
     wait_cost_per_s: int
+    start: int = 0
 
     def route_cost(self, route: Sequence[int]) -> float:
-        """The objective's value of a route of stops (depot around it), in its unit."""
-        order = [0, *route, 0]
+        """The objective's value of a route of stops (from the start, back to the depot), in
+        its unit."""
+        order = [self.start, *route, 0]
         arcs = self.arc_cost[order[:-1], order[1:]]
         return float(arcs.sum()) * self.unit_value + self.offset * (len(order) - 1)
 
     def route_energy_j(self, route: Sequence[int]) -> float:
-        """The estimated energy of a route of stops (depot around it) [J]."""
-        order = [0, *route, 0]
+        """The estimated energy of a route of stops (from the start, back to the depot) [J]."""
+        order = [self.start, *route, 0]
         return float(self.energy_j[order[:-1], order[1:]].sum())
 
 
@@ -168,7 +172,8 @@ def van_estimates(
     door_w = abs(float(door_heat_w(box, ambient_c, box.setpoint_c))) / float(
         refrigeration_cop(box, ambient_c, box.setpoint_c)
     )
-    door_j = np.array([0.0] + [door_w * stop.door_open_s for stop in stops])
+    door_j = np.zeros(len(service_s))  # the depot's and the vans' positions: none
+    door_j[1 : len(stops) + 1] = [door_w * stop.door_open_s for stop in stops]
     stop_j = parked_w * service_s + door_j
     battery = problem.van.battery
     budget_j = (

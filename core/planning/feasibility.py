@@ -41,7 +41,7 @@ class Feasibility:
         if budget is not None and day.estimates[v].route_energy_j(route) > budget:
             broken.append("battery")
         clock, end = day.shift_s[v]
-        for k, (i, j) in enumerate(itertools.pairwise([0, *route, 0])):
+        for k, (i, j) in enumerate(itertools.pairwise(day.order(v, route))):
             clock += day.service_s[i] + self.travel_s[i, j]
             if j == 0 and k == len(route):
                 break
@@ -70,8 +70,8 @@ class Feasibility:
                 f"it takes {stop.delivery_kg:g} kg; no van carries that much (largest payload "
                 f"{max(payloads):g} kg)",
             )
-        start_s, end_s = day.shift_s[v]
-        window = next_window(start_s + self.travel_s[0, node], day.windows_s[node])
+        end_s = day.shift_s[v][1]
+        window = next_window(self._reach_s(v, node), day.windows_s[node])
         if window is None:
             latest = at(day.reference, day.windows_s[node][-1][1])
             return Failure(
@@ -80,7 +80,7 @@ class Feasibility:
                 f"the earliest any van gets there is {day.clock(self.earliest(node))}, "
                 f"after its last window closes at {latest:%H:%M}",
             )
-        if self._back_s(start_s, node) > end_s:
+        if self._back_s(v, node) > end_s:
             return Failure(
                 "shift",
                 node,
@@ -100,19 +100,24 @@ class Feasibility:
             )
         return None
 
-    def _back_s(self, start_s: float, node: int) -> float:
-        """Return to the depot of a round to ``node`` alone leaving at ``start_s`` [s];
-        infinite when its windows have all closed."""
-        window = next_window(start_s + self.travel_s[0, node], self.day.windows_s[node])
+    def _reach_s(self, v: int, node: int) -> float:
+        """When van ``v`` reaches ``node`` on a round to it alone [s]."""
+        return self.day.shift_s[v][0] + self.travel_s[self.day.starts[v], node]
+
+    def _back_s(self, v: int, node: int) -> float:
+        """Van ``v``'s return to the depot from a round to ``node`` alone [s]; infinite when
+        its windows have all closed."""
+        come_s = self._reach_s(v, node)
+        window = next_window(come_s, self.day.windows_s[node])
         if window is None:
             return math.inf
-        serve = max(start_s + self.travel_s[0, node], window[0])
+        serve = max(come_s, window[0])
         return serve + self.day.service_s[node] + self.travel_s[node, 0]
 
     def earliest(self, node: int) -> float:
         """The earliest any van reaches ``node`` [s]."""
-        return min(start + self.travel_s[0, node] for start, _ in self.day.shift_s)
+        return min(self._reach_s(v, node) for v in self.day.vans)
 
     def earliest_back(self, node: int) -> float:
         """The earliest any van is back from a round to ``node`` alone [s]."""
-        return min(self._back_s(start, node) for start, _ in self.day.shift_s)
+        return min(self._back_s(v, node) for v in self.day.vans)

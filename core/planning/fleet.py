@@ -31,7 +31,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from core.clock import check_representable, departure
-from core.exceptions import CoreError, InvalidParameterError
+from core.exceptions import CoreError, InvalidParameterError, NoRouteError
+from core.params import Place
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import WeatherService, forecast_for
 from core.planning.day import FleetDay, VanShift, fleet_day, leg_roads
@@ -52,8 +53,9 @@ from core.planning.model import (
     fields_of,
 )
 from core.planning.repair import Repaired, fitting, repair
-from core.planning.scene import Scene, legs_for
+from core.planning.scene import Scene, legs_for, round_field
 from core.planning.solver_input import routing_input
+from core.planning.start_state import START_ID, check_start, under_way
 from core.planning.timeline import client_legs_too_fast, drive_time_s
 from core.planning.verify import Failure, route_failure, traced_seconds
 from core.routing.geo import build_legs
@@ -93,8 +95,24 @@ def plan_fleet(
     """
     started = time.perf_counter()
     shifts, timezone_name = check_fleet(problem)
-    places = [*problem.places, *problem.chargers]
-    legs = legs_for(problem, router, places)
+    under_way = [k for k, v in enumerate(problem.vehicles) if v.start_state is not None]
+    positions = [
+        Place(id=START_ID, lat=state.lat, lon=state.lon)
+        for k in under_way
+        if (state := problem.vehicles[k].start_state) is not None
+    ]
+    places = [*problem.places, *positions, *problem.chargers]
+    start_fields = [f"vehicles[{k}].start_state" for k in under_way]
+    legs = legs_for(problem, router, places, start_fields)
+    for index in legs.unreachable():
+        if index > len(problem.stops) and index < len(places) - len(problem.chargers):
+            raise NoRouteError(
+                "no road links the van's position with the depot",
+                round_field(problem, places, index, start_fields),
+            )
+    starts = [0] * len(shifts)
+    for n, k in enumerate(under_way):
+        starts[k] = len(problem.stops) + 1 + n
     first = min(shift.start for shift in shifts)
     last = max(shift.end for shift in shifts if shift.end is not None)
     # One forecast for the whole day, shared by every van.
@@ -119,7 +137,7 @@ def plan_fleet(
     deadline = started + problem.time_limit_s
     charging = problem.depot.charger is not None or bool(problem.chargers)
     routed = search(
-        fleet_day(shifts, scene, remembering),
+        fleet_day(shifts, scene, remembering, starts),
         problem.minimize_vehicles,
         deadline - problem.time_limit_s * CHARGING_SHARE if charging else deadline,
         deadline if charging else None,
@@ -146,9 +164,10 @@ def plan_fleet(
 
 def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
     """Everything about a fleet plan that can be checked without solving it: unique ids of
-    stops and vans, each shift's start and end on the day in the zone, the client's matrix.
-    Raises :class:`core.exceptions.CoreError` naming the field; returns each van's shift and
-    the zone's name."""
+    stops and vans, each shift's start and end on the day in the zone, each start state
+    (its time within the shift), the client's matrix. Raises
+    :class:`core.exceptions.CoreError` naming the field; returns each van's shift (from its
+    start state's time when under way) and the zone's name."""
     check_places(problem)
     vans: dict[str, int] = {}
     for index, vehicle in enumerate(problem.vehicles):
@@ -180,9 +199,18 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
             time_limit_s=problem.time_limit_s,
             breaks=vehicle.breaks,
             **fields_of(vehicle, TripFields),
+            start_state=vehicle.start_state,
             van=vehicle.van,
         )
-        shifts.append(VanShift(vehicle.id, round_problem, ends[0], ends[1]))
+        field = f"vehicles[{index}].start_state"
+        now = check_start(round_problem, ends[0].tzinfo, field, fleet=True)
+        if now is not None and not ends[0] <= now < ends[1]:
+            raise InvalidParameterError(
+                f"{now:%H:%M} is outside the van's shift {vehicle.shift_start:%H:%M}–"
+                f"{vehicle.shift_end:%H:%M}",
+                f"{field}.time",
+            )
+        shifts.append(VanShift(vehicle.id, under_way(round_problem), now or ends[0], ends[1]))
     if problem.matrix is not None:
         build_legs(problem.places, problem.matrix)
     return shifts, timezone_name
@@ -212,7 +240,7 @@ def calibrate(day: FleetDay, times: LearnedTimes) -> None:
     matrix is driven as it says."""
     if day.scene.legs.source == "client":
         return
-    reachable = [k for k in range(1, day.n) if k not in day.unreachable]
+    reachable = [k for k in day.stop_nodes if k not in day.unreachable]
     sample = reachable[:: max(len(reachable) // CALIBRATION_STOPS, 1)][:CALIBRATION_STOPS]
     arcs = []
     for k in sample:
@@ -291,7 +319,7 @@ def search(
         routes = outcome.routes if outcome is not None else [[] for _ in day.vans]
         results = {v: day.simulate(v, route) for v, route in enumerate(routes) if route}
         for v, result in results.items():
-            times.learn(traced_seconds([0, *routes[v], 0], result))
+            times.learn(traced_seconds(day.order(v, routes[v]), result))
         failures = {
             v: failure
             for v, result in results.items()
@@ -317,7 +345,7 @@ def search(
     served = {node for route in routes for node in route}
     unassigned = [
         explain(rules, node, left_out.get(node), routes)
-        for node in range(1, day.n)
+        for node in day.stop_nodes
         if node not in served
     ]
     if charging_until is not None:

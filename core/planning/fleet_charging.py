@@ -20,9 +20,9 @@ import math
 import time
 from dataclasses import dataclass, field, replace
 
-from core.params import ChargePoint, Place
+from core.params import ChargePoint
 from core.planning.day import FleetDay
-from core.planning.model import DEPOT_CHARGER_ID, PlanProblem, PlanResult, Unassigned
+from core.planning.model import DEPOT_CHARGER_ID, PlanResult, Unassigned
 from core.planning.recharge import Busy, visits_of
 from core.planning.scene import charge_points
 from core.planning.timeline import ChargeVisit
@@ -90,7 +90,7 @@ def serve_with_charging(
     stops left out for their battery served by vans that charge where they can; the rest of
     ``unassigned`` as it was."""
     places = day.scene.places
-    bookings = Bookings(charge_points(day.shifts[0].problem))
+    bookings = Bookings(charge_points(day.shifts[0].problem, places))
     place_of = {place.id: k for k, place in enumerate(places)}
     served: set[int] = set()
     for stop in unassigned:
@@ -102,7 +102,7 @@ def serve_with_charging(
                 break
             v = insertion.v
             shift = day.shifts[v]
-            order, charges = _with_stop(shift.problem, places, results.get(v), insertion)
+            order, charges = _with_stop(day, results.get(v), insertion)
             result = day.charged(v, order, charges, bookings.busy(shift.id))
             if route_failure(shift.id, shift.problem, places, result, shift.end, True) is None:
                 routes[v], results[v] = insertion.route, result
@@ -135,13 +135,15 @@ class _Insertion:
 
 
 def _with_stop(
-    problem: PlanProblem, places: list[Place], driven: PlanResult | None, insertion: _Insertion
+    day: FleetDay, driven: PlanResult | None, insertion: _Insertion
 ) -> tuple[list[int], dict[int, ChargeVisit]]:
     """The order the van drives its longer route in, keeping the chargers and charges of
     what it drove before (``driven``)."""
+    v = insertion.v
     if driven is None:
-        return [0, *insertion.route, 0], {}
-    order, charges = visits_of(problem, places, driven)
+        return day.order(v, insertion.route), {}
+    problem = day.shifts[v].problem
+    order, charges = visits_of(problem, day.scene.places, driven, day.starts[v])
     after = 0  # where the route's place before the insertion is in the order
     for place in insertion.route[: insertion.k]:
         after = order.index(place, after + 1)
@@ -150,15 +152,15 @@ def _with_stop(
     return order, {q + shift * (q > after): c for q, c in charges.items()}
 
 
-def _placings(route: list[int], node: int) -> list[tuple[int, list[int]]]:
+def _placings(route: list[int], node: int, under_way: bool) -> list[tuple[int, list[int]]]:
     """Where and how ``node`` may join ``route``: at each position, alone, or with a return
     to reload before or after it (when a trip would get too heavy for the van); never a
-    return at an end or beside another."""
+    return at an end (but the first of a van ``under_way``) or beside another."""
     out = []
     for k in range(len(route) + 1):
         for placed in ([node], [0, node], [node, 0]):
             longer = [*route[:k], *placed, *route[k:]]
-            if trips_tidied(longer) == longer:
+            if trips_tidied(longer, under_way) == longer:
                 out.append((k, placed))
     return out
 
@@ -181,7 +183,7 @@ def _candidates(
             idle.add(kind)
         before = estimates.route_cost(route)
         tried: list[tuple[float, int, _Insertion]] = []
-        for k, placed in _placings(route, node):
+        for k, placed in _placings(route, node, day.starts[v] != 0):
             longer = [*route[:k], *placed, *route[k:]]
             if day.carries(v, longer):
                 extra = estimates.route_cost(longer) - before

@@ -203,7 +203,19 @@ class TripFields(Params):
     )
 
 
-class PlanFields(RoundFields, TripFields):
+class StartFields(Params):
+    """Where a van's day starts: the depot, or where it is now."""
+
+    start_state: StartState | None = Field(
+        None,
+        description="Plan the rest of a day from where the van is (its position, time, charge, "
+        "box temperature, payload, driving since the last break) to the depot; without a "
+        "client matrix (in /v1/plans: rounds without time windows; in fleets: its time "
+        "within the van's shift). Absent: from the depot at the start of the day.",
+    )
+
+
+class PlanFields(RoundFields, TripFields, StartFields):
     """One round: when it leaves, and whether its order is the client's."""
 
     start_time: ClockTime = clock_field(
@@ -214,13 +226,6 @@ class PlanFields(RoundFields, TripFields):
     keep_order: bool = Field(False, description="Drive the stops in the given order.")
     time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT_S)
     breaks: Breaks = breaks_field("none")
-    start_state: StartState | None = Field(
-        None,
-        description="Plan the rest of a day from where the van is (its position, time, charge, "
-        "box temperature, payload, driving since the last break) to the depot; rounds "
-        "without time windows and without a client matrix. Absent: from the depot at "
-        "start_time.",
-    )
 
 
 class PlanProblem(PlanFields):
@@ -236,7 +241,7 @@ def shift_in_order(start: dt.time | None, end: dt.time) -> dt.time:
     return end
 
 
-class ShiftFields(TripFields):
+class ShiftFields(TripFields, StartFields):
     """One van of a fleet without its parameters: its id, its driver's shift and its trips."""
 
     id: str = Field(

@@ -97,7 +97,7 @@ def with_charges(
     (by position in ``order``) are visits to start from, fitted again: a plan that changed a
     little keeps its charges where they still serve (:func:`visits_of`)."""
     day = _Round(problem, scene, start, roads, solved, windows_s, latest_return_s, busy or {})
-    points = charge_points(problem)
+    points = charge_points(problem, scene.places)
     if charges:  # the visits of an earlier plan, fitted again (open when free now)
         first = {
             q: replace(c, open_s=day.open_s(order[q], points[order[q]])) for q, c in charges.items()
@@ -250,15 +250,13 @@ def _without(windows: Windows, taken: Windows) -> list[tuple[float, float]]:
 
 
 def visits_of(
-    problem: PlanProblem, places: list[Place], result: PlanResult
+    problem: PlanProblem, places: list[Place], result: PlanResult, start: int = 0
 ) -> tuple[list[int], dict[int, ChargeVisit]]:
-    """The order (place indices) a plan drove and its charges by position, as visits to start
-    a changed plan from."""
+    """The order (place indices) a plan drove from place ``start`` (the depot, or the van's
+    position) and its charges by position, as visits to start a changed plan from."""
     index = {place.id: k for k, place in enumerate(places)}
-    order = [0, *(index[i] for i in result.tour[1:-1]), 0]
-    if result.tour[0] != places[0].id:  # under way: from the van's position
-        order[0] = index[result.tour[0]]
-    points = charge_points(problem)
+    order = [start, *(index[i] for i in result.tour[1:-1]), 0]
+    points = charge_points(problem, places)
     by_arrival = {charge.arrive: charge for charge in result.charges}
     reloaded = {reload.arrive for reload in result.reloads}
     visits = {}

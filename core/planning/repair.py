@@ -20,14 +20,14 @@ def fitting(rules: Feasibility, v: int, route: list[int]) -> list[int]:
     """The route less its last stops until the estimates accept it."""
     route = list(route)
     while route and rules.violations(v, route):
-        route = trips_tidied(route[:-1])
+        route = trips_tidied(route[:-1], rules.day.starts[v] != 0)
     return route
 
 
 def costliest(estimates: VanEstimates, route: list[int]) -> int:
     """The stop whose removal saves the most estimated energy (not a return to reload)."""
     energy = estimates.energy_j
-    order = [0, *route, 0]
+    order = [estimates.start, *route, 0]
     savings = [
         energy[order[k - 1], order[k]]
         + energy[order[k], order[k + 1]]
@@ -65,7 +65,7 @@ def repair(
     current: Failure | None = failure
     while route and current is not None:
         node = current.node if current.node is not None else costliest(estimates, route)
-        route = trips_tidied([n for n in route if n != node])
+        route = trips_tidied([n for n in route if n != node], estimates.start != 0)
         removed[node] = current
         if not route:
             return Repaired(route, None, removed)

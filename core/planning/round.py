@@ -202,7 +202,7 @@ def _in_windows(
             field or f"stops[{index}]",
         )
     result = routed.routes[0].plan
-    if not result.battery.feasible and charge_points(problem):
+    if not result.battery.feasible and charge_points(problem, scene.places):
         order, _ = visits_of(problem, scene.places, result)
         charged = day.charged(0, order, {}, {})
         if charged.battery.margin_kwh > result.battery.margin_kwh:

@@ -5,7 +5,7 @@ from (:func:`legs_for`)."""
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from core.exceptions import InvalidStopsError, OffRoadError
@@ -40,41 +40,53 @@ def round_places(problem: PlanProblem) -> list[Place]:
     return [*problem.places, *start, *problem.chargers]
 
 
-def charge_points(problem: PlanProblem) -> dict[int, ChargePoint]:
-    """Where a round may charge, by place index (:func:`round_places`): the depot's charger
-    and the chargers on the way."""
-    first = len(problem.stops) + 1 + (problem.start_state is not None)
+def charge_points(problem: PlanProblem, places: Sequence[Place]) -> dict[int, ChargePoint]:
+    """Where a round may charge, by index of ``places`` (a round's, :func:`round_places`, or
+    a fleet's; the chargers on the way last): the depot's charger and the chargers on the
+    way."""
+    first = len(places) - len(problem.chargers)
     points: dict[int, ChargePoint] = {first + k: c for k, c in enumerate(problem.chargers)}
     if problem.depot.charger is not None:
         points[0] = problem.depot.charger
     return points
 
 
-def round_field(problem: RoundFields, places: list[Place], index: int) -> str:
-    """The request field of place ``index`` of ``places`` (the depot, a stop, the van's
-    position or a charger on the way)."""
+def round_field(
+    problem: RoundFields,
+    places: list[Place],
+    index: int,
+    start_fields: Sequence[str] = ("start_state",),
+) -> str:
+    """The request field of place ``index`` of ``places`` (the depot, a stop, a van's
+    position — ``start_fields`` name them in order — or a charger on the way)."""
     if index == 0:
         return "depot"
     if index <= len(problem.stops):
         return f"stops[{index - 1}]"
     first_charger = len(places) - len(problem.chargers)
     if index < first_charger:
-        return "start_state"
+        return start_fields[index - len(problem.stops) - 1]
     return f"chargers[{index - first_charger}]"
 
 
 def legs_for(
-    problem: RoundFields, router: RoadRouter | None, places: list[Place] | None = None
+    problem: RoundFields,
+    router: RoadRouter | None,
+    places: list[Place] | None = None,
+    start_fields: Sequence[str] = ("start_state",),
 ) -> Legs:
     """Every ordered pair's leg between ``places`` (by default the depot and the stops): the
-    client's matrix, else the router's table, else the estimate."""
+    client's matrix, else the router's table, else the estimate. A place off the road is an
+    error naming its field (:func:`round_field`)."""
     places = problem.places if places is None else places
     try:
         table = router.table(places) if router is not None and problem.matrix is None else None
     except OffRoadError as error:
         if error.place is None or error.place <= len(problem.stops):
             raise
-        raise InvalidStopsError(error.message, round_field(problem, places, error.place)) from None
+        raise InvalidStopsError(
+            error.message, round_field(problem, places, error.place, start_fields)
+        ) from None
     return build_legs(places, problem.matrix, table)
 
 

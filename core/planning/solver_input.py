@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from core.planning.feasibility import Feasibility
+from core.planning.start_state import start_payload_kg
 from core.routing.units import energy_units_down, energy_units_up, payload_units_down
 from core.routing.vrp import RoutingInput, VehicleSpec
 
@@ -42,6 +43,9 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
                 wait_cost_per_s=estimates.wait_cost_per_s,
                 max_reloads=shift.problem.max_trips - 1,
                 reload_s=math.ceil(shift.problem.reload_minutes * 60),
+                start=day.starts[v],
+                initial_load_g=payload_units_down(shift.problem.van.payload_kg)
+                - payload_units_down(start_payload_kg(shift.problem)),
             )
         )
     never = [(day.horizon_s + 1, day.horizon_s + 1)]
@@ -50,7 +54,8 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
         inside = [(max(math.ceil(a), 0), min(math.floor(b), day.horizon_s)) for a, b in place]
         kept = [(a, b) for a, b in inside if a <= b]
         hopeless = node > 0 and (
-            node in day.unreachable
+            node not in day.stop_nodes  # a van's position: where it sets off, not a stop
+            or node in day.unreachable
             or (place and not kept)
             or all(rules.alone(v, node) for v in day.vans)
         )

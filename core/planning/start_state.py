@@ -22,58 +22,73 @@ from core.routing.tsp import Tour, solve_path
 START_ID = "start"
 
 
-def check_start(problem: PlanProblem, zone: dt.tzinfo | None) -> dt.datetime | None:
+def check_start(
+    problem: PlanProblem, zone: dt.tzinfo | None, field: str = "start_state", fleet: bool = False
+) -> dt.datetime | None:
     """The departure from the van's position in the round's zone, or None without a start
-    state; raises :class:`core.exceptions.InvalidParameterError` naming the field for what
-    cannot be planned from it."""
+    state; raises :class:`core.exceptions.InvalidParameterError` naming the field (``field``
+    and below) for what cannot be planned from it. A round (not ``fleet``) has no time
+    windows and carries every stop from where it is; a fleet's van carries no more than its
+    payload."""
     state = problem.start_state
     if state is None:
         return None
     if problem.matrix is not None:
         raise InvalidParameterError(
             "a client matrix has no row for the van's position: leave out matrix (the "
-            "planner estimates the legs or asks its router) or start_state",
-            "start_state",
+            f"planner estimates the legs or asks its router) or {field}",
+            field,
         )
-    if any(stop.time_windows for stop in problem.stops):
+    if not fleet and any(stop.time_windows for stop in problem.stops):
         raise InvalidParameterError(
-            "a start state is planned for rounds without time windows", "start_state"
+            "a start state is planned for rounds without time windows", field
         )
     battery = problem.van.battery
     if state.soc < battery.min_soc + MIN_SOC_WINDOW:
         raise InvalidParameterError(
             f"soc {state.soc:g} is less than {MIN_SOC_WINDOW:g} above the reserve min_soc "
             f"{battery.min_soc:g}: the van cannot plan a round on it",
-            "start_state.soc",
+            f"{field}.soc",
         )
     delivered = sum(stop.delivery_kg for stop in problem.stops)
-    if state.payload_kg is not None and state.payload_kg < delivered - 1e-9:
+    if not fleet and state.payload_kg is not None and state.payload_kg < delivered - 1e-9:
         raise InvalidParameterError(
             f"payload_kg {state.payload_kg:g} is less than the {delivered:g} kg the stops left "
             "take",
-            "start_state.payload_kg",
+            f"{field}.payload_kg",
+        )
+    if fleet and state.payload_kg is not None and state.payload_kg > problem.van.payload_kg:
+        raise InvalidParameterError(
+            f"payload_kg {state.payload_kg:g} is more than the van's payload_kg "
+            f"{problem.van.payload_kg:g}",
+            f"{field}.payload_kg",
         )
     moment = state.time.astimezone(zone)
     if moment.date() != problem.date:
         raise InvalidParameterError(
             f"{state.time.isoformat()} is on {moment.date()} in the round's zone, not on the "
             f"round's date {problem.date}",
-            "start_state.time",
+            f"{field}.time",
         )
     return moment
 
 
 def under_way(problem: PlanProblem) -> PlanProblem:
-    """The round with the van as it is now: its charge and payload (the start state's)."""
+    """The round with the van's battery as it is now (the start state's charge)."""
     state = problem.start_state
     if state is None:
         return problem
     van = problem.van
     battery = van.battery.model_copy(update={"initial_soc": state.soc})
-    payload = van.payload_kg if state.payload_kg is None else state.payload_kg
-    return problem.model_copy(
-        update={"van": van.model_copy(update={"battery": battery, "payload_kg": payload})}
-    )
+    return problem.model_copy(update={"van": van.model_copy(update={"battery": battery})})
+
+
+def start_payload_kg(problem: PlanProblem) -> float:
+    """What the van carries when it sets off: its payload, or the start state's [kg]."""
+    state = problem.start_state
+    if state is None or state.payload_kg is None:
+        return problem.van.payload_kg
+    return state.payload_kg
 
 
 def box_start_c(problem: PlanProblem) -> float | None:

@@ -39,6 +39,7 @@ from core.physics.cycles import (
 from core.physics.motor import power_limited
 from core.physics.simulate import MAX_SPEED_MPS
 from core.planning.model import PlanProblem
+from core.planning.start_state import start_payload_kg
 from core.routing.geo import STREET_TYPE_NAMES, Legs, street_type_by_speed
 from core.routing.roads import LegRoute, bearing_deg
 
@@ -487,7 +488,7 @@ def build_timeline(
     window closes is served at once and listed in ``late``. ``rest``: the driver's breaks,
     taken between stops (:meth:`_Builder.rest_before`)."""
     rest = rest or Rest()
-    day = _Builder(problem.van.payload_kg, rest=rest, driving_s=rest.driven_s)
+    day = _Builder(start_payload_kg(problem), rest=rest, driving_s=rest.driven_s)
     for k, (i, j) in enumerate(itertools.pairwise(order)):
         a, b = places[i], places[j]
         route = routes[k] if routes is not None else None

@@ -32,7 +32,7 @@ from core.planning.model import (
     UnassignedReason,
 )
 from core.planning.scene import Scene, charge_points
-from core.planning.start_state import box_start_c
+from core.planning.start_state import box_start_c, start_payload_kg
 from core.planning.timeline import (
     PLAN_DT_S,
     ChargeVisit,
@@ -186,7 +186,7 @@ class _Split:
     def stops(self) -> list[StopResult]:
         places, soc, snap = self.scene.places, self.simulated.soc, self.scene.legs.snap_distance_m
         out = []
-        payload = self.problem.van.payload_kg
+        payload = start_payload_kg(self.problem)
         reloads = set(self.timeline.reloaded_at)
         for k, j in enumerate(self.order[1:-1]):
             if k + 1 in reloads:
@@ -217,7 +217,7 @@ class _Split:
 
     def charges(self) -> list[ChargeResult]:
         """The charges between stops, with what the simulation made of them."""
-        points = charge_points(self.problem)
+        points = charge_points(self.problem, self.scene.places)
         out = []
         for position, spell, done in zip(
             self.timeline.charged_at, self.timeline.charging, self.simulated.charges, strict=True

@@ -69,6 +69,11 @@ class VehicleSpec:
         route); its payload is then back to ``payload_capacity_g``.
     reload_s
         How long a reload takes [s].
+    start
+        The place the van sets off from: the depot (0), or another (its position when it
+        is under way; no stop's). It ends at the depot.
+    initial_load_g
+        What of ``payload_capacity_g`` its first trip cannot take [g] (it set off with less).
     """
 
     arc_cost: IntMatrix
@@ -80,6 +85,8 @@ class VehicleSpec:
     wait_cost_per_s: int = 0
     max_reloads: int = 0
     reload_s: int = 0
+    start: int = 0
+    initial_load_g: int = 0
 
 
 @dataclass(frozen=True)
@@ -166,7 +173,7 @@ def route_energy(problem: RoutingInput, v: int, route: list[int]) -> int:
     energy = problem.vehicles[v].energy
     if energy is None:
         return 0
-    order = [0, *route, 0]
+    order = [problem.vehicles[v].start, *route, 0]
     return int(energy[order[:-1], order[1:]].sum())
 
 
@@ -187,7 +194,7 @@ def _within_energy(problem: RoutingInput, v: int, route: list[int]) -> list[int]
         and problem.vehicles[v].energy is not None
     ):
         kept.pop()
-    return trips_tidied(kept)
+    return trips_tidied(kept, problem.vehicles[v].start != 0)
 
 
 def trips_of(route: Sequence[int]) -> list[list[int]]:
@@ -201,11 +208,12 @@ def trips_of(route: Sequence[int]) -> list[list[int]]:
     return [trip for trip in trips if trip]
 
 
-def trips_tidied(route: list[int]) -> list[int]:
-    """``route`` without returns to reload that have no stop after them (or before)."""
+def trips_tidied(route: list[int], under_way: bool = False) -> list[int]:
+    """``route`` without returns to reload that have no stop after them (or before, unless
+    the van is ``under_way``: it may reload before its first stop)."""
     kept: list[int] = []
     for node in route:
-        if node or (kept and kept[-1]):
+        if node or (kept and kept[-1]) or (under_way and not kept):
             kept.append(node)
     while kept and not kept[-1]:
         kept.pop()
@@ -229,6 +237,8 @@ def _kind(vehicle: VehicleSpec) -> tuple[object, ...]:
         vehicle.shift_s,
         vehicle.max_reloads,
         vehicle.reload_s,
+        vehicle.start,
+        vehicle.initial_load_g,
     )
 
 
@@ -246,7 +256,7 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
     groups: list[pyvrp.ClientGroup] = []
     for node in range(1, n):
         windows = problem.windows_s[node] or [(0, horizon)]
-        if windows[0][0] >= never:  # no van can ever serve it: not in the model
+        if windows[0][0] >= never:  # no van can ever serve it (or a van sets off there)
             continue
         members = []
         for opens, closes in windows:
@@ -278,8 +288,14 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
     matrices: dict[int, int] = {}
     distance_matrices: list[IntMatrix] = []
     vehicle_types = []
-    # the depot to start and end at, then one at the same place per reload time (its service)
+    # the depot to start and end at, the vans' positions under way, then one at the depot's
+    # place per reload time (its service)
     depots = [pyvrp.Depot(location=0, tw_early=0, tw_late=horizon)]
+    start_depot: dict[int, int] = {0: 0}
+    for vehicle in problem.vehicles:
+        if vehicle.start not in start_depot:
+            start_depot[vehicle.start] = len(depots)
+            depots.append(pyvrp.Depot(location=vehicle.start, tw_early=0, tw_late=horizon))
     reload_depot: dict[int, int] = {}
     for vehicle in problem.vehicles:
         if vehicle.max_reloads and vehicle.reload_s not in reload_depot:
@@ -306,6 +322,8 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
                 profile=matrices[key],
                 reload_depots=[reload_depot[vehicle.reload_s]] if vehicle.max_reloads else [],
                 max_reloads=vehicle.max_reloads,
+                start_depot=start_depot[vehicle.start],
+                initial_load=[int(vehicle.initial_load_g)],
             )
         )
     travel = np.asarray(problem.travel_s, dtype=np.int64)
@@ -360,11 +378,12 @@ def _pyvrp_start(model: _PyvrpModel, initial: list[list[int]] | None) -> pyvrp.S
         kind = van_type[v]
         reload = model.data.vehicle_type(kind).reload_depots
         nodes = [n for n in route if n in model.node_clients or (not n and reload)]
+        under_way = model.data.vehicle_type(kind).start_depot != 0
         activities = [
             pyvrp.Activity(pyvrp.ActivityType.CLIENT, model.node_clients[node][0])
             if node
             else pyvrp.Activity(pyvrp.ActivityType.DEPOT, reload[0])
-            for node in trips_tidied(nodes)
+            for node in trips_tidied(nodes, under_way)
         ]
         if activities:
             routes.append(pyvrp.Route(model.data, activities, kind))
@@ -411,7 +430,9 @@ def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapc
     """The routing model: each van's arc costs and fixed cost; the time, payload and energy
     dimensions; a disjunction per stop."""
     n = problem.travel_s.shape[0]
-    manager = pywrapcp.RoutingIndexManager(n, len(problem.vehicles), 0)
+    starts = [v.start for v in problem.vehicles]
+    manager = pywrapcp.RoutingIndexManager(n, len(problem.vehicles), starts, [0] * len(starts))
+    stops = [node for node in range(1, n) if node not in starts]
     routing = pywrapcp.RoutingModel(manager)
     callbacks: dict[int, int] = {}
 
@@ -429,7 +450,7 @@ def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapc
     time_matrix = np.minimum(problem.travel_s + problem.service_s[:, None], horizon + 1)
     routing.AddDimension(matrix_callback(time_matrix), horizon, horizon + 1, False, "time")
     clock = routing.GetDimensionOrDie("time")
-    for node in range(1, n):
+    for node in stops:
         windows = problem.windows_s[node]
         if not windows:
             continue
@@ -445,7 +466,11 @@ def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapc
         clock.SetSlackCostCoefficientForVehicle(int(vehicle.wait_cost_per_s), v)
     demand = routing.RegisterUnaryTransitVector(problem.demand_g.tolist())
     routing.AddDimensionWithVehicleCapacity(
-        demand, 0, [int(v.payload_capacity_g) for v in problem.vehicles], True, "payload"
+        demand,
+        0,
+        [int(v.payload_capacity_g - v.initial_load_g) for v in problem.vehicles],
+        True,
+        "payload",
     )
     if any(v.energy is not None for v in problem.vehicles):
         zero = np.zeros((n, n), dtype=np.int64)
@@ -456,6 +481,6 @@ def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapc
             True,
             "energy",
         )
-    for node in range(1, n):
+    for node in stops:
         routing.AddDisjunction([manager.NodeToIndex(node)], int(problem.drop_penalty))
     return manager, routing
