@@ -352,9 +352,14 @@ def search(
         routes, results, unassigned = serve_with_charging(
             day, routes, results, unassigned, minimize_vehicles, charging_until
         )
+    for v in day.vans:  # a van under way with no stop left drives back to the depot
+        if day.starts[v] and not routes[v]:
+            results[v] = day.simulate(v, [])
     return Routed(
         routes=[
-            FleetRoute(day.shifts[v].id, results[v]) for v in day.vans if routes[v] and v in results
+            FleetRoute(day.shifts[v].id, results[v])
+            for v in day.vans
+            if (routes[v] or day.starts[v]) and v in results
         ],
         unassigned=unassigned,
         verification_rounds=rounds,

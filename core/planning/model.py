@@ -209,9 +209,10 @@ class StartFields(Params):
     start_state: StartState | None = Field(
         None,
         description="Plan the rest of a day from where the van is (its position, time, charge, "
-        "box temperature, payload, driving since the last break) to the depot; without a "
-        "client matrix (in /v1/plans: rounds without time windows; in fleets: its time "
-        "within the van's shift). Absent: from the depot at the start of the day.",
+        "box temperature, payload, driving since the last break) to the depot, leaving at "
+        "its time; without a client matrix (in fleets: its time within the van's shift, its "
+        "payload at most payload_kg, its first trip what it has aboard). Absent: from the "
+        "depot at the start of the day.",
     )
 
 

@@ -191,7 +191,8 @@ def _in_windows(
     (:func:`core.planning.recharge.with_charges`)."""
     remembering = None if router is None else RememberingRouter(router)
     van = VanShift("van", problem, start, None, battery_enforced=False)
-    day = fleet_day([van], scene, remembering)
+    under_way = [len(problem.stops) + 1] if problem.start_state is not None else None
+    day = fleet_day([van], scene, remembering, under_way)
     routed = search(day, minimize_vehicles=False, deadline=started + problem.time_limit_s)
     if routed.unassigned:
         first = routed.unassigned[0]
@@ -203,7 +204,7 @@ def _in_windows(
         )
     result = routed.routes[0].plan
     if not result.battery.feasible and charge_points(problem, scene.places):
-        order, _ = visits_of(problem, scene.places, result)
+        order, _ = visits_of(problem, scene.places, result, day.starts[0])
         charged = day.charged(0, order, {}, {})
         if charged.battery.margin_kwh > result.battery.margin_kwh:
             result = replace(charged, solved=result.solved)

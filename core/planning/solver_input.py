@@ -39,7 +39,7 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
                 energy_capacity=0 if budget is None else energy_units_down(budget),
                 payload_capacity_g=payload_units_down(shift.problem.van.payload_kg),
                 shift_s=(math.ceil(start_s), math.floor(end_s)),
-                fixed_cost=fixed + v,
+                fixed_cost=v if day.starts[v] else fixed + v,  # one under way drives anyway
                 wait_cost_per_s=estimates.wait_cost_per_s,
                 max_reloads=shift.problem.max_trips - 1,
                 reload_s=math.ceil(shift.problem.reload_minutes * 60),

@@ -27,9 +27,8 @@ def check_start(
 ) -> dt.datetime | None:
     """The departure from the van's position in the round's zone, or None without a start
     state; raises :class:`core.exceptions.InvalidParameterError` naming the field (``field``
-    and below) for what cannot be planned from it. A round (not ``fleet``) has no time
-    windows and carries every stop from where it is; a fleet's van carries no more than its
-    payload."""
+    and below) for what cannot be planned from it. A round (not ``fleet``) carries every
+    stop from where it is; a fleet's van carries no more than its payload."""
     state = problem.start_state
     if state is None:
         return None
@@ -38,10 +37,6 @@ def check_start(
             "a client matrix has no row for the van's position: leave out matrix (the "
             f"planner estimates the legs or asks its router) or {field}",
             field,
-        )
-    if not fleet and any(stop.time_windows for stop in problem.stops):
-        raise InvalidParameterError(
-            "a start state is planned for rounds without time windows", field
         )
     battery = problem.van.battery
     if state.soc < battery.min_soc + MIN_SOC_WINDOW:

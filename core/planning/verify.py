@@ -91,7 +91,7 @@ def simulate_route(
         return build_timeline(problem, places, legs, order, roads, windows, charges, rest)
 
     timeline = laid_out(start, windows_s)
-    if windows_s is not None:
+    if windows_s is not None and problem.start_state is None:  # under way: it drives on now
         delay_s = later_departure_s(timeline, order, windows_s, latest_return_s)
         if delay_s > 0:  # every span after the departure comes as much nearer
             start = at(start, delay_s)

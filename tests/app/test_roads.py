@@ -187,6 +187,27 @@ def test_a_van_in_the_sea_is_named_as_its_start_state(roads):
     assert planned.json()["distance_source"] == "osrm"
 
 
+def test_a_fleet_van_in_the_sea_is_named_and_one_on_a_street_drives_on_roads(roads):
+    at_sea = {"lat": 43.70, "lon": 7.45, "time": "2026-07-15T10:00:00+02:00", "soc": 0.8}
+    body = monaco_plan(["moneghetti", "casino", "palais", "gare"])
+    body.pop("start_time")
+    body["vehicles"] = [
+        {"id": "van-0", "shift_start": "09:00", "shift_end": "12:00"},
+        {"id": "van-1", "shift_start": "09:00", "shift_end": "12:00", "start_state": at_sea},
+    ]
+    response = roads.post("/v1/fleet-plans", json=body)
+    assert response.status_code == 422
+    error = response.json()["errors"][0]
+    assert error["field"] == "vehicles[1].start_state" and "nearest road" in error["message"]
+    on_land = at_sea | {"lat": PLACES["condamine"][0], "lon": PLACES["condamine"][1]}
+    body["vehicles"][1]["start_state"] = on_land
+    planned = roads.post("/v1/fleet-plans", json=body)
+    assert planned.status_code == 200, planned.text
+    (under_way,) = [r for r in planned.json()["routes"] if r["vehicle_id"] == "van-1"]
+    assert under_way["tour"][0] == "start" and under_way["distance_source"] == "osrm"
+    assert under_way["legs"][0]["depart"] == "2026-07-15T10:00:00+02:00"
+
+
 # Two road islands 3 km apart with no road between them, as OpenStreetMap XML (osrm-extract
 # reads .osm as well as .osm.pbf).
 ISLANDS_OSM = """<?xml version="1.0" encoding="UTF-8"?>

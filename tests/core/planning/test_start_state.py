@@ -99,17 +99,24 @@ def test_a_start_state_that_cannot_be_planned_is_refused_naming_the_field(
     assert raised.value.field == field
 
 
-def test_a_start_state_with_windows_or_a_client_matrix_is_refused(morning, planned):
+def test_a_round_under_way_keeps_its_windows(morning, planned):
+    """The fleet search with this one van from its position: the stop that wants 14:00–15:00
+    is served then, the others around it."""
     state = at_noon(morning, planned)
-    stops = [
-        state.stops[0].model_copy(
-            update={"time_windows": [TimeWindow(start="14:00", end="15:00")]}
-        ),
-        *state.stops[1:],
-    ]
-    with pytest.raises(InvalidParameterError) as raised:
-        plan(state.model_copy(update={"stops": stops}))
-    assert raised.value.field == "start_state"
+    window = TimeWindow(start="14:00", end="15:00")
+    stops = [state.stops[0].model_copy(update={"time_windows": [window]}), *state.stops[1:]]
+    rest = plan(state.model_copy(update={"stops": stops, "time_limit_s": 3.0}))
+    assert rest.tour[0] == START_ID and rest.tour[-1] == morning.depot.id
+    assert sorted(rest.tour[1:-1]) == sorted(s.id for s in stops)
+    assert rest.legs[0].depart == state.start_state.time  # it waits where the window is
+    assert rest.legs[0].soc_start == pytest.approx(state.start_state.soc)
+    served = next(s for s in rest.stops if s.id == stops[0].id).service_start.time()
+    assert window.start <= served <= window.end
+    assert rest.late_stops == []
+
+
+def test_a_start_state_with_a_client_matrix_is_refused(morning, planned):
+    state = at_noon(morning, planned)
     n = len(state.stops) + 1
     off = [[0.0 if i == j else 1000.0 for j in range(n)] for i in range(n)]
     matrix = RoadMatrix(distances_m=off, durations_s=[[v / 10 for v in row] for row in off])
