@@ -1,6 +1,7 @@
 """Run every benchmark: ``python -m benchmarks`` (``make bench``)."""
 
 from benchmarks import (
+    bench_calibration,
     bench_energy,
     bench_fleet,
     bench_planner,
@@ -15,6 +16,7 @@ for module in (
     bench_planner,
     bench_roads,
     bench_studies,
+    bench_calibration,
     bench_fleet,
     evrptw,
     bench_serving,

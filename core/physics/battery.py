@@ -72,6 +72,8 @@ class BatteryVerdict:
         Energy from the grid to bring the battery back to its initial state of charge [kWh].
     first_infeasible_index
         First sample whose state of charge is below the reserve, or None.
+    reserve_soc
+        The reserve it was held to: the battery's ``min_soc`` [–].
     """
 
     feasible: bool
@@ -82,6 +84,7 @@ class BatteryVerdict:
     usable_capacity_kwh: float
     recharge_kwh: float
     first_infeasible_index: int | None
+    reserve_soc: float
 
 
 def discharge(
@@ -124,4 +127,5 @@ def discharge(
         * capacity_kwh
         / battery.charging_efficiency,
         first_infeasible_index=int(below[0]) if below.size else None,
+        reserve_soc=battery.min_soc,
     )

@@ -94,7 +94,9 @@ def power_limited(
     steps = speed_mps.size - 1
     mass = np.broadcast_to(np.asarray(mass_kg, dtype=float), (steps,))
     slope = np.broadcast_to(np.asarray(grade, dtype=float), (steps,))
-    if mechanical_power_w(vehicle, speed_mps, dt_s, mass, slope).max() <= cap * (1 + CAP_TOLERANCE):
+    power = mechanical_power_w(vehicle, speed_mps, dt_s, mass, slope)
+    limit = cap * (1 + CAP_TOLERANCE)
+    if power.max() <= limit:
         return None
     pieces: list[FloatArray] = []
     origins: list[FloatArray] = []
@@ -104,8 +106,11 @@ def power_limited(
             pieces.append(speed_mps[placed:first])
             origins.append(np.arange(placed, first) * dt_s)
         asked = speed_mps[first : last + 1]
-        driven = _drive_move(vehicle, cap, asked, dt_s, mass[first:last], slope[first:last])
-        origin = first * dt_s + _origin_s(asked, driven, dt_s)
+        if power[first:last].max() <= limit:  # the cap does not bind on this move: as asked
+            driven, origin = asked, np.arange(first, last + 1) * dt_s
+        else:
+            driven = _drive_move(vehicle, cap, asked, dt_s, mass[first:last], slope[first:last])
+            origin = first * dt_s + _origin_s(asked, driven, dt_s)
         shared = 1 if placed > first else 0  # a one-sample stop both moves touch
         pieces.append(driven[shared:])
         origins.append(origin[shared:])
