@@ -54,7 +54,7 @@ ROUTING_SHARE = 0.15
 #: PyVRP's integers: distances and times this many per unit.
 _SCALE = 1000
 #: Customers taken out and put back by one ruin-and-recreate move.
-RUIN_SIZE = 6
+RUIN_SIZE = 14
 #: A customer is inserted only into routes that hold one of its this many nearest customers
 #: (a granular neighbourhood, Toth & Vigo 2003).
 NEIGHBOURS = 15
@@ -64,6 +64,9 @@ MEMO_SIZE = 1_000_000
 #: distance), and the share of the time left one attempt may take.
 LATE_PENALTY = 1000.0
 ELIMINATION_SHARE = 0.1
+#: The most of the search's time all attempts to empty a route may take together: a fleet
+#: that cannot lose a van leaves the rest to the distance.
+ELIMINATION_BUDGET = 0.4
 #: Ruin-and-recreate moves on the distance between two attempts to empty a route; the most
 #: a move may worsen the distance at first [share]; rounds between attempts at a vehicle less
 #: once every route has had its turn.
@@ -279,10 +282,12 @@ class _Search:
         nothing as the time runs out: threshold accepting, Dueck & Scheuer 1990), then an
         attempt at a vehicle less (in at most :data:`ELIMINATION_SHARE` of the time left; the
         next smallest route after each that fails, and once every routes' turn is over, only
-        every :data:`ELIMINATION_EVERY` rounds), and again. The best routes seen are kept."""
+        every :data:`ELIMINATION_EVERY` rounds; all in at most :data:`ELIMINATION_BUDGET` of the
+        time), and again. The best routes seen are kept."""
         began = time.perf_counter()
         self.keep_if_best()
         nth = rounds = 0
+        eliminating_s = 0.0
         while time.perf_counter() < deadline:
             rounds += 1
             for _ in range(DISTANCE_MOVES):
@@ -294,8 +299,14 @@ class _Search:
                 self.keep_if_best()
             if nth >= len(self.routes) and rounds % ELIMINATION_EVERY:
                 continue
-            left = deadline - time.perf_counter()
-            if self._eliminate(time.perf_counter() + left * ELIMINATION_SHARE, nth):
+            now = time.perf_counter()
+            budget_s = ELIMINATION_BUDGET * (deadline - began) - eliminating_s
+            if budget_s <= 0:
+                continue
+            until = now + min((deadline - now) * ELIMINATION_SHARE, budget_s)
+            eliminated = self._eliminate(until, nth)
+            eliminating_s += time.perf_counter() - now
+            if eliminated:
                 nth = 0
                 self.keep_if_best()
             else:
