@@ -8,7 +8,8 @@ OSRM := .router/osrm/bin/osrm-routed
 PBF ?=
 ROUTER_DIR ?= .router/region
 
-.PHONY: test bench serve worker openapi report lint clean router router-serve
+.PHONY: test bench serve worker openapi report lint clean router router-serve wheelhouse image \
+	test-image
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -18,7 +19,7 @@ $(STAMP): pyproject.toml
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/ruff format --check core app tests benchmarks tools report
+	$(BIN)/ruff format --check core app tests benchmarks tools report image_tests
 	$(BIN)/mypy core app report
 	$(BIN)/lint-imports
 
@@ -68,5 +69,30 @@ openapi: $(STAMP)
 report: $(STAMP)
 	$(BIN)/python -m report.paper
 
+# The container image, built without network from a wheelhouse made here (the base's Python
+# 3.11.2 wants async-timeout, which this 3.11's markers leave out). BASE: any Debian-like image
+# with Python 3.11 and its venv module.
+IMAGE ?= coldroute
+BASE ?= python:3.11-slim
+wheelhouse: $(STAMP)
+	rm -rf wheelhouse
+	$(BIN)/python -m pip wheel --quiet . 'async-timeout>=4' -w wheelhouse
+
+image: wheelhouse
+	docker build --network none --build-arg BASE=$(BASE) -t $(IMAGE) .
+
+# The image tried as an operator would, with this machine's own dockerd and a base made by
+# debootstrap from Debian's packages (root; Debian's docker.io and debootstrap). Not in `make
+# test`: a laptop without Docker runs the test suite.
+DOCKERD := /usr/sbin/dockerd
+DEBOOTSTRAP := /usr/sbin/debootstrap
+$(DOCKERD) $(DEBOOTSTRAP):
+	$(SUDO) apt-get install -y --no-install-recommends docker.io debootstrap \
+		|| ($(SUDO) apt-get update && $(SUDO) apt-get install -y --no-install-recommends docker.io debootstrap)
+
+test-image: wheelhouse $(DOCKERD) $(DEBOOTSTRAP)
+	$(BIN)/python -m pytest image_tests -p no:cacheprovider
+	rm -rf wheelhouse
+
 clean:
-	rm -rf $(VENV) .router .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) .router .pytest_cache .mypy_cache .ruff_cache wheelhouse

@@ -99,14 +99,15 @@ class Server:
         )
         self.process: subprocess.Popen[bytes] | None = None
 
-    def start(self, timeout_s: float = 30.0) -> Server:
+    def start(self, timeout_s: float = 60.0) -> Server:
         # The server's log goes to a file: a pipe nobody reads would fill and stall it.
         self.log_path = Path(tempfile.mkstemp(prefix="coldroute-server-", suffix=".log")[1])
+        log = self.log_path.open("wb")
         self.process = subprocess.Popen(
             [sys.executable, "-m", "app.serve"],
             env=self.env,
-            stdout=subprocess.DEVNULL,
-            stderr=self.log_path.open("wb"),
+            stdout=log,  # the JSON lines
+            stderr=log,  # anything else that goes wrong
         )
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
@@ -117,7 +118,10 @@ class Server:
                     return self
             except httpx.TransportError:
                 time.sleep(0.1)
-        raise RuntimeError(f"the server did not start within {timeout_s:g} s")
+        self.close()  # not left running behind the error
+        raise RuntimeError(
+            f"the server did not start within {timeout_s:g} s: {self.log_path.read_text()[-2000:]}"
+        )
 
     def stop(self) -> None:
         if self.process is not None and self.process.poll() is None:
