@@ -165,6 +165,7 @@ def _http(request: Request, error: StarletteHTTPException) -> JSONResponse:
         401: "Unauthorized",
         404: "Not found",
         405: "Method not allowed",
+        409: "Conflict",
         413: "Request too large",
     }
     title = titles.get(error.status_code, "HTTP error")

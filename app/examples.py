@@ -179,20 +179,77 @@ SCENARIOS_EXAMPLE: dict[str, Any] = {
 }
 
 
+def _calibration_example() -> dict[str, Any]:
+    """Two ten-minute trips at 1 Hz (stop-and-go, then a fast road) of the real reefer van
+    with more drag and auxiliaries than its preset, as its telematics would log them: the
+    battery power of each second, to the watt."""
+    import datetime as dt
+
+    import numpy as np
+
+    from core.params import PRESETS, Location
+    from core.physics.simulate import CONSUMERS, simulate
+
+    van = PRESETS["ev-van-3.5t-reefer"].van()
+    truth = van.model_copy(
+        update={
+            "vehicle": van.vehicle.model_copy(
+                update={"drag_coefficient": 0.38, "auxiliaries_power_w": 520.0}
+            )
+        }
+    )
+
+    def pattern(top_mps: float, cruise_s: int, stand_s: int) -> list[float]:
+        ramp = [min(k * 1.0, top_mps) for k in range(int(top_mps) + 1)]
+        once = ramp + [top_mps] * cruise_s + ramp[::-1] + [0.0] * stand_s
+        return (once * (601 // len(once) + 1))[:601]
+
+    start = dt.datetime(2026, 7, 15, 9, tzinfo=dt.UTC)
+    location = Location(lat=48.21, lon=16.37)
+    trips = []
+    for k, speed in enumerate([pattern(13.0, 30, 15), pattern(25.0, 120, 5)]):
+        begins = start + dt.timedelta(hours=k)
+        result = simulate(np.array(speed), 1.0, begins, location, truth)
+        power = np.sum([result.power_w[c] for c in CONSUMERS], axis=0)
+        logged = np.concatenate([[power[0]], power])
+        trips.append(
+            {
+                "id": ["city", "ring-road"][k],
+                "start": begins.isoformat(),
+                "location": {"lat": 48.21, "lon": 16.37},
+                "time_s": list(range(len(speed))),
+                "speed_mps": speed,
+                "battery_power_w": [round(float(w)) for w in logged],
+            }
+        )
+    return {
+        "vehicle": {"preset": "ev-van-3.5t-reefer"},
+        "parameters": ["drag_coefficient", "auxiliaries_power_w"],
+        "trips": trips,
+    }
+
+
+CALIBRATION_EXAMPLE: dict[str, Any] = _calibration_example()
+
+
 def record() -> dict[str, Any]:
     """The answers of the examples above from a real run (``python -m app.examples`` writes
     them to app/response_examples.json, which Swagger shows)."""
     import datetime as dt
+    import tempfile
 
     from app.jobs.schemas import JobOut
-    from app.operations import fleet_plan, plan, simulate, studies
+    from app.operations import calibration, fleet_plan, plan, simulate, studies
+    from app.schemas.calibration import CalibrationRequest
     from app.schemas.fleet import FleetPlanRequest
     from app.schemas.plans import PlanRequest
     from app.schemas.simulate import SimulateRequest
     from app.schemas.studies import ScenariosRequest, SpeedSweepRequest
     from app.settings import Settings
 
-    settings = Settings()
+    # The calibration's record goes to a database of its own, not to the checkout's.
+    database = tempfile.mkdtemp(prefix="coldroute-examples-")
+    settings = Settings(database_url=f"sqlite:///{database}/examples.db")
     planned = plan.plan_response(plan.run_plan(PlanRequest.model_validate(PLAN_EXAMPLE), settings))
     plan_json = planned.model_dump(mode="json")
     accepted = dt.datetime(2026, 7, 14, 22, 0, 3, tzinfo=dt.UTC)
@@ -221,6 +278,10 @@ def record() -> dict[str, Any]:
             ScenariosRequest.model_validate(SCENARIOS_EXAMPLE), settings
         ).model_dump(mode="json"),
         "job": job.model_dump(mode="json"),
+        "calibration": calibration.run_calibration(
+            CalibrationRequest.model_validate(CALIBRATION_EXAMPLE), settings
+        ).model_dump(mode="json")
+        | {"id": "3b9d2f64-8c1e-4a7b-b0d5-6e2a9c4f7d13"},
     }
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import datetime as dt
 import json
 import logging
+import sys
 from collections.abc import Callable
 from contextvars import ContextVar
 from typing import Any
@@ -56,13 +57,14 @@ def _stamped(factory: Callable[..., logging.LogRecord]) -> Callable[..., logging
 
 
 def configure_logging(level: str) -> None:
-    """Every log record of this process as a JSON line on stderr, warnings included (a plain
-    stderr handler someone installed before is replaced; a test's capturing handler stays)."""
+    """Every log record of this process as a JSON line on stdout (where containers and
+    process managers collect a service's log), warnings included (a plain stream handler
+    someone installed before is replaced; a test's capturing handler stays)."""
     root = logging.getLogger()
     root.handlers[:] = [
         h for h in root.handlers if type(h) is not logging.StreamHandler and not _ours(h)
     ]
-    handler = logging.StreamHandler()
+    handler = logging.StreamHandler(sys.stdout)
     handler.setFormatter(JsonLines())
     root.addHandler(handler)
     root.setLevel(level.upper())

@@ -30,7 +30,18 @@ from app.jobs.store import store_for
 from app.logs import REQUEST_ID, configure_logging
 from app.metrics import Metrics
 from app.operations.kinds import loaded
-from app.routers import fleet, health, jobs, plans, presets, simulate, studies
+from app.routers import (
+    calibrations,
+    fleet,
+    health,
+    jobs,
+    plans,
+    presets,
+    profiles,
+    simulate,
+    studies,
+    viewer,
+)
 from app.routes import RouteTemplates
 from app.schemas.plans import PlanFeatureCollection
 from app.settings import Settings, get_settings
@@ -45,8 +56,14 @@ the drive-train, cab and refrigeration model of *"Wholistic simulation of an all
 refrigerated delivery vehicle"* and says whether the battery holds out with its reserve. `POST
 /v1/fleet-plans` splits the day's stops across several vans with time windows, shifts, payload and
 each battery as constraints, and verifies every route by the full simulation. `POST /v1/simulate`
-gives the energy of one speed trace. Units are in the field names (`_m`, `_s`, `_kwh`, `_c`...).
-Errors are `application/problem+json` (RFC 9457)."""
+gives the energy of one speed trace. `POST /v1/calibrations` fits the model to a van's measured
+trips (JSON, or CSV files at `/v1/calibrations/csv`), and `/v1/vehicle-profiles` keeps your vans by
+name — from a preset with changes or from a calibration — for any request's
+`"vehicle": {"profile": …}`. Units are in the field names (`_m`, `_s`, `_kwh`, `_c`...).
+Errors are `application/problem+json` (RFC 9457).
+
+**[The plan viewer](/viewer)** plans a day from a CSV of stops and shows it: the routes on a map,
+the state of charge, the energy per consumer and the box temperature over the day."""
 
 
 class BodyLimit:
@@ -347,10 +364,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.metrics = metrics
     errors.install(app)
     v1 = APIRouter(prefix="/v1", dependencies=[Depends(require_api_key)])
-    for module in (plans, fleet, simulate, presets, studies, jobs):
+    for module in (plans, fleet, simulate, presets, profiles, studies, calibrations, jobs):
         v1.include_router(module.router)
     app.include_router(v1)
     app.include_router(health.router)
+    app.include_router(viewer.router)
 
     @app.get("/metrics", include_in_schema=False)
     def prometheus() -> Response:

@@ -24,6 +24,11 @@ STATUS_TEXT = {
     503: "The service cannot take this now (workers busy, shutting down, or an outside "
     "service down); see Retry-After.",
 }
+#: What a status means for the vehicle profiles' operations, where the jobs' text is wrong.
+PROFILE_STATUS_TEXT = {
+    404: "No vehicle profile of that name.",
+    409: "A vehicle profile of that name exists (PUT replaces it).",
+}
 #: The error statuses each operation can answer.
 ERRORS: dict[str, tuple[int, ...]] = {
     "createPlan": (401, 413, 422, 503),
@@ -31,7 +36,14 @@ ERRORS: dict[str, tuple[int, ...]] = {
     "simulateTrace": (401, 413, 422, 503),
     "sweepSpeeds": (401, 413, 422, 503),
     "runScenarios": (401, 413, 422, 503),
+    "createCalibration": (401, 413, 422, 503),
+    "createCalibrationFromCsv": (401, 413, 422, 503),
     "listPresets": (401,),
+    "createVehicleProfile": (401, 409, 413, 422, 503),
+    "listVehicleProfiles": (401, 503),
+    "getVehicleProfile": (401, 404, 422, 503),
+    "replaceVehicleProfile": (401, 413, 422, 503),
+    "deleteVehicleProfile": (401, 404, 422, 503),
     "createJob": (401, 409, 413, 422, 503),
     "listJobs": (401, 422, 503),
     "getJob": (401, 404, 422, 503),
@@ -45,6 +57,7 @@ EXAMPLES = {
     "sweepSpeeds": "speed_sweep",
     "runScenarios": "scenarios",
     "getJob": "job",
+    "createCalibration": "calibration",
 }
 
 
@@ -75,9 +88,10 @@ def finish(schema: dict[str, Any], extra_models: list[type[BaseModel]]) -> dict[
             for status in [s for s in responses if s.startswith(("4", "5"))]:
                 if not (operation_id == "getReadiness" and status == "503"):
                     del responses[status]
+            own = PROFILE_STATUS_TEXT if path.startswith("/v1/vehicle-profiles") else {}
             for status in ERRORS.get(operation_id, ()):
                 responses[str(status)] = {
-                    "description": STATUS_TEXT[status],
+                    "description": own.get(status, STATUS_TEXT[status]),
                     "content": {PROBLEM_JSON: {"schema": {"$ref": "#/components/schemas/Problem"}}},
                 }
             if path.startswith("/v1/"):

@@ -26,6 +26,16 @@ class Settings(BaseSettings):
     cors_origins: list[str] = Field(
         default_factory=list, description='Allowed CORS origins, JSON list: ["https://a.b"].'
     )
+    tile_url: Annotated[str, Field(pattern=r"^(https?://[^\s'\"<>]*\{z\}[^\s'\"<>]*)?$")] = Field(
+        "https://tile.openstreetmap.org/{z}/{x}/{y}.png",
+        description="Map tiles of the plan viewer (/viewer): an XYZ URL with {z}, {x}, {y} "
+        "(and {s} for a subdomain); empty for none (the routes draw on a plain background).",
+    )
+    tile_attribution: str = Field(
+        "© OpenStreetMap contributors",
+        max_length=200,
+        description="The credit the viewer shows under its tiles.",
+    )
     api_key: SecretStr | None = Field(
         None, description="When set, every /v1 request needs this value in X-API-Key."
     )
@@ -48,6 +58,12 @@ class Settings(BaseSettings):
         gt=0,
         description="Most time a synchronous study may simulate [s] (about a year of driving, "
         "a few seconds of work); beyond, a 413 points to jobs, which have no such bound.",
+    )
+    max_sync_calibration_samples: int = Field(
+        100_000,
+        ge=2,
+        description="Most samples, over all trips, a synchronous calibration fits (28 h at "
+        "1 Hz, some ten seconds of work); beyond, a 413 points to jobs, which have no such bound.",
     )
     max_time_limit_s: float = Field(
         10.0, gt=0, description="Cap on a request's solver time_limit_s [s]."

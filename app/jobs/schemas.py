@@ -62,6 +62,9 @@ class JobOut(JobSummary):
         description="When succeeded: exactly what the synchronous endpoint returns.",
     )
     error: Problem | None = Field(None, description="When failed: why, as a problem document.")
+    request: dict[str, Any] | None = Field(
+        None, description="The request as it was submitted (GET with include_request=true)."
+    )
 
 
 class JobList(ApiModel):

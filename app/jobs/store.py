@@ -11,28 +11,17 @@ import datetime as dt
 import hashlib
 import json
 import uuid
-from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from functools import lru_cache
-from pathlib import Path
 from typing import Any
 
-from alembic import command
-from alembic.config import Config
-from sqlalchemy import ColumnElement, Engine, create_engine, delete, event, select, text, update
+from sqlalchemy import ColumnElement, delete, select, text, update
 from sqlalchemy.exc import IntegrityError
-from sqlalchemy.orm import Session, sessionmaker
+from sqlalchemy.orm import Session
 
+from app.database import database_for, now
 from app.jobs.models import ACTIVE, FINISHED, Job
-
-MIGRATIONS = Path(__file__).with_name("migrations")
-#: A lock key for migrations on PostgreSQL, so replicas starting together upgrade once.
-_MIGRATION_LOCK = 7_317_001
-
-
-def now() -> dt.datetime:
-    return dt.datetime.now(dt.UTC)
 
 
 def request_hash(job_type: str, request: dict[str, Any]) -> str:
@@ -93,40 +82,19 @@ class JobStore:
 
     def __init__(self, url: str) -> None:
         self.url = url
-        sqlite = url.startswith("sqlite")
-        self.engine: Engine = create_engine(
-            url,
-            pool_pre_ping=True,
-            connect_args={"check_same_thread": False, "timeout": 30} if sqlite else {},
-        )
-        if sqlite:
-            event.listen(self.engine, "connect", _sqlite_pragmas)
-        self._session = sessionmaker(self.engine, expire_on_commit=False)
-        self._migrated = False
+        self.database = database_for(url)
+        self.engine = self.database.engine
 
     def migrate(self) -> None:
-        """Bring the schema to the newest Alembic revision (idempotent)."""
-        if self._migrated:
-            return
-        config = Config()
-        config.set_main_option("script_location", str(MIGRATIONS))
-        with self.engine.begin() as connection:
-            if connection.dialect.name == "postgresql":
-                connection.execute(text(f"SELECT pg_advisory_xact_lock({_MIGRATION_LOCK})"))
-            config.attributes["connection"] = connection
-            command.upgrade(config, "head")
-        self._migrated = True
+        """Bring the database to the newest revision (idempotent)."""
+        self.database.migrate()
 
-    @contextmanager
-    def _transaction(self) -> Iterator[Session]:
-        self.migrate()
-        with self._session.begin() as session:
-            yield session
+    def transaction(self) -> AbstractContextManager[Session]:
+        return self.database.transaction()
 
     def ping(self) -> None:
         """Raise when the database cannot be reached."""
-        with self.engine.connect() as connection:
-            connection.execute(text("SELECT 1"))
+        self.database.ping()
 
     def create(
         self,
@@ -156,7 +124,7 @@ class JobStore:
             created_at=now(),
         )
         try:
-            with self._transaction() as session:
+            with self.transaction() as session:
                 session.add(job)
         except IntegrityError:  # the same key, sent twice at once: the other one won
             existing = self.by_key(idempotency_key) if idempotency_key else None
@@ -168,18 +136,18 @@ class JobStore:
         return JobView.of(job), True
 
     def get(self, job_id: str) -> JobView | None:
-        with self._transaction() as session:
+        with self.transaction() as session:
             job = session.get(Job, job_id)
             return None if job is None else JobView.of(job)
 
     def by_key(self, key: str) -> JobView | None:
-        with self._transaction() as session:
+        with self.transaction() as session:
             job = session.scalars(select(Job).where(Job.idempotency_key == key)).first()
             return None if job is None else JobView.of(job)
 
     def recent(self, status: str | None = None, limit: int = 50) -> list[JobView]:
         """The newest jobs first, optionally of one status."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             query = select(Job).order_by(Job.created_at.desc(), Job.id).limit(limit)
             if status is not None:
                 query = query.where(Job.status == status)
@@ -187,7 +155,7 @@ class JobStore:
 
     def counts(self) -> dict[str, int]:
         """Jobs per status."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             rows = session.execute(text("SELECT status, COUNT(*) FROM jobs GROUP BY status"))
             return {str(status): int(count) for status, count in rows}
 
@@ -204,7 +172,7 @@ class JobStore:
         )
         if self.engine.dialect.name == "postgresql":
             oldest = oldest.with_for_update(skip_locked=True)
-        with self._transaction() as session:
+        with self.transaction() as session:
             taken = session.execute(
                 update(Job)
                 .where(Job.id == oldest.scalar_subquery(), Job.status == "queued")
@@ -224,7 +192,7 @@ class JobStore:
         if stale_after_s is not None:
             silent_since = moment - dt.timedelta(seconds=stale_after_s)
             takeable = takeable | ((Job.status == "running") & (Job.heartbeat_at < silent_since))
-        with self._transaction() as session:
+        with self.transaction() as session:
             taken = session.execute(
                 update(Job).where(Job.id == job_id, takeable).values(_running(runner, moment))
             )
@@ -236,7 +204,7 @@ class JobStore:
     def heartbeat(self, job_ids: list[str], runner: str) -> None:
         if not job_ids:
             return
-        with self._transaction() as session:
+        with self.transaction() as session:
             session.execute(
                 update(Job)
                 .where(Job.id.in_(job_ids), Job.status == "running", Job.runner == runner)
@@ -252,7 +220,7 @@ class JobStore:
     ) -> bool:
         """Record the answer of a running job of ``runner``; False when it was cancelled or
         taken over meanwhile (the answer is then dropped)."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             done = session.execute(
                 update(Job)
                 .where(Job.id == job_id, Job.status == "running", Job.runner == runner)
@@ -271,7 +239,7 @@ class JobStore:
         """Put a running job back in the queue: its runner lost it (any runner), a retry that
         may run ``after_s`` from now, or a run cut short by a shutdown that does not ``count``
         as an attempt."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             query = update(Job).where(Job.id == job_id, Job.status == "running")
             if runner is not None:
                 query = query.where(Job.runner == runner)
@@ -288,7 +256,7 @@ class JobStore:
 
     def cancel(self, job_id: str) -> JobView | None:
         """Cancel a queued or running job (a finished one stays as it is)."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             session.execute(
                 update(Job)
                 .where(Job.id == job_id, Job.status.in_(ACTIVE))
@@ -301,7 +269,7 @@ class JobStore:
         """Which of these jobs were cancelled."""
         if not job_ids:
             return []
-        with self._transaction() as session:
+        with self.transaction() as session:
             return list(
                 session.scalars(
                     select(Job.id).where(Job.id.in_(job_ids), Job.status == "cancelled")
@@ -311,7 +279,7 @@ class JobStore:
     def stale(self, stale_after_s: float) -> list[JobView]:
         """Running jobs whose runner has been silent for ``stale_after_s``."""
         silent_since = now() - dt.timedelta(seconds=stale_after_s)
-        with self._transaction() as session:
+        with self.transaction() as session:
             query = select(Job).where(Job.status == "running", Job.heartbeat_at < silent_since)
             return [JobView.of(job) for job in session.scalars(query)]
 
@@ -322,13 +290,13 @@ class JobStore:
         sent: ColumnElement[bool] = Job.dispatched_at.is_(None)
         if resend_after_s is not None:
             sent = sent | (Job.dispatched_at < moment - dt.timedelta(seconds=resend_after_s))
-        with self._transaction() as session:
+        with self.transaction() as session:
             query = select(Job).where(Job.status == "queued", _due(moment), sent)
             return [JobView.of(job) for job in session.scalars(query)]
 
     def forget_dispatches(self) -> int:
         """The broker lost its messages: every queued job counts as never sent; how many."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             done = session.execute(
                 update(Job)
                 .where(Job.status == "queued", Job.dispatched_at.is_not(None))
@@ -342,7 +310,7 @@ class JobStore:
         conditional ``UPDATE``, so two dispatchers never both send one attempt."""
         moment = now()
         before = moment - dt.timedelta(seconds=resend_after_s)
-        with self._transaction() as session:
+        with self.transaction() as session:
             taken = session.execute(
                 update(Job)
                 .where(
@@ -357,7 +325,7 @@ class JobStore:
 
     def undo_dispatch(self, job_id: str) -> None:
         """The send failed: the job waits for the next dispatch."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             session.execute(
                 update(Job)
                 .where(Job.id == job_id, Job.status == "queued")
@@ -366,7 +334,7 @@ class JobStore:
 
     def fail_exhausted(self, job_id: str, max_attempts: int, error: dict[str, Any]) -> bool:
         """Fail a queued or running job that has used its attempts."""
-        with self._transaction() as session:
+        with self.transaction() as session:
             done = session.execute(
                 update(Job)
                 .where(Job.id == job_id, Job.status.in_(ACTIVE), Job.attempts >= max_attempts)
@@ -377,7 +345,7 @@ class JobStore:
     def purge(self, retention_s: float) -> int:
         """Delete jobs finished more than ``retention_s`` ago; how many."""
         before = now() - dt.timedelta(seconds=retention_s)
-        with self._transaction() as session:
+        with self.transaction() as session:
             gone = session.execute(
                 delete(Job).where(Job.status.in_(FINISHED), Job.finished_at < before)
             )
@@ -399,14 +367,6 @@ def _running(runner: str, moment: dt.datetime) -> dict[str, Any]:
         "run_after": None,
         "attempts": Job.attempts + 1,
     }
-
-
-def _sqlite_pragmas(connection: Any, _: Any) -> None:
-    # WAL lets the server read while a runner writes; the busy timeout waits out short locks.
-    cursor = connection.cursor()
-    cursor.execute("PRAGMA journal_mode=WAL")
-    cursor.execute("PRAGMA busy_timeout=30000")
-    cursor.close()
 
 
 @lru_cache(maxsize=8)

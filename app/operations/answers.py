@@ -21,6 +21,7 @@ def battery(
     return BatteryOut(
         feasible=verdict.feasible,
         min_soc=verdict.min_soc,
+        reserve_soc=verdict.reserve_soc,
         final_soc=verdict.final_soc,
         margin_kwh=verdict.margin_kwh,
         required_capacity_kwh=verdict.required_capacity_kwh,
@@ -40,8 +41,14 @@ def weather(used: Weather, source: WeatherSource, days: list[DayWeather]) -> Wea
     )
 
 
-def box(max_temperature_c: float | None, minutes_above: float | None) -> BoxOut:
-    return BoxOut(max_temperature_c=max_temperature_c, minutes_above_product_limit=minutes_above)
+def box(
+    max_temperature_c: float | None, minutes_above: float | None, product_limit_c: float
+) -> BoxOut:
+    return BoxOut(
+        max_temperature_c=max_temperature_c,
+        minutes_above_product_limit=minutes_above,
+        product_limit_c=product_limit_c,
+    )
 
 
 def attribution(distance_source: str) -> str | None:

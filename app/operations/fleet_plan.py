@@ -7,6 +7,7 @@ from app import connectors
 from app.operations.answers import attribution, energy
 from app.operations.limits import check_round, time_limit_s
 from app.operations.plan import plan_response
+from app.operations.vans import van_of
 from app.schemas.fleet import (
     FleetPlanRequest,
     FleetPlanResponse,
@@ -35,7 +36,7 @@ def fleet_problem(request: FleetPlanRequest, settings: Settings) -> FleetProblem
     vehicles = []
     for index, vehicle in enumerate(request.vehicles):
         try:
-            van = vehicle.van()
+            van = van_of(vehicle, settings)
         except CoreError as error:
             raise error.under(f"vehicles[{index}]") from None
         vehicles.append(FleetVehicle(**fields_of(vehicle, ShiftFields), van=van))
@@ -60,12 +61,14 @@ def run_fleet_plan(request: FleetPlanRequest, settings: Settings) -> FleetResult
     )
 
 
-def fleet_response(result: FleetResult, include_geometry: bool = False) -> FleetPlanResponse:
+def fleet_response(
+    result: FleetResult, include_geometry: bool = False, include_profile: bool = False
+) -> FleetPlanResponse:
     """The answer of ``POST /v1/fleet-plans``."""
     return FleetPlanResponse(
         routes=[
             FleetRouteOut(
-                **dict(plan_response(route.plan, include_geometry)),
+                **dict(plan_response(route.plan, include_geometry, include_profile)),
                 vehicle_id=route.vehicle_id,
             )
             for route in result.routes
@@ -95,4 +98,4 @@ def fleet_response(result: FleetResult, include_geometry: bool = False) -> Fleet
 
 def answer(request: FleetPlanRequest, result: FleetResult) -> FleetPlanResponse:
     """What the endpoint answers a fleet plan request with (as JSON)."""
-    return fleet_response(result, request.include_geometry)
+    return fleet_response(result, request.include_geometry, request.include_profile)

@@ -4,13 +4,15 @@ synchronous endpoint returns."""
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
 from pydantic import BaseModel
 
-from app.operations import fleet_plan, plan, studies
+from app.operations import calibration, fleet_plan, plan, studies
+from app.schemas.calibration import CalibrationRequest, CalibrationResponse
 from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
 from app.schemas.plans import PlanRequest, PlanResponse
 from app.schemas.studies import (
@@ -92,6 +94,15 @@ JOB_KINDS: dict[str, JobKind[Any, Any]] = {
         lambda _request, response: response,
         lambda _request: 0.0,  # no solver: the sweep's simulations alone
     ),
+    "calibration": JobKind(
+        CalibrationRequest,
+        CalibrationResponse,
+        "of /v1/calibrations",
+        calibration.check_job,
+        calibration.run_calibration,
+        lambda _request, response: response,
+        lambda _request: 0.0,  # no solver: the fit's simulations alone
+    ),
 }
 
 
@@ -108,6 +119,7 @@ def run_job(kind: str, request: dict[str, Any], settings: Settings) -> dict[str,
         update={
             "max_time_limit_s": settings.max_job_time_limit_s,
             "max_sync_simulated_s": float("inf"),  # a job may simulate as long as it must
+            "max_sync_calibration_samples": sys.maxsize,
         }
     )
     job = JOB_KINDS[kind]

@@ -7,10 +7,12 @@ from typing import Any
 from app import connectors
 from app.operations.answers import attribution, battery, box, energy, weather
 from app.operations.limits import check_round, time_limit_s
-from app.schemas.base import EnergyShare, LineString, Point
+from app.operations.vans import van_of
+from app.schemas.base import EnergySeries, EnergyShare, LineString, Point
 from app.schemas.plans import (
     BreakOut,
     ChargeOut,
+    DayProfileOut,
     Feature,
     LegOut,
     PlanFeatureCollection,
@@ -22,7 +24,7 @@ from app.schemas.plans import (
     Totals,
 )
 from app.settings import Settings
-from core.planning.model import PlanFields, PlanProblem, PlanResult, fields_of
+from core.planning.model import DayProfile, PlanFields, PlanProblem, PlanResult, fields_of
 from core.planning.round import check, plan
 
 
@@ -32,7 +34,7 @@ def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
     return PlanProblem(
         **fields_of(request, PlanFields)
         | {"time_limit_s": time_limit_s(request.time_limit_s, settings)},
-        van=request.van(),
+        van=van_of(request, settings),
     )
 
 
@@ -50,7 +52,9 @@ def run_plan(request: PlanRequest, settings: Settings) -> PlanResult:
     )
 
 
-def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanResponse:
+def plan_response(
+    result: PlanResult, include_geometry: bool = False, include_profile: bool = False
+) -> PlanResponse:
     """The answer of ``POST /v1/plans`` for a planned round."""
     legs = []
     for leg in result.legs:
@@ -81,7 +85,11 @@ def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanRes
         battery=battery(result.battery, result.first_infeasible_leg, result.battery_loss_kwh),
         weather=weather(result.weather, result.weather_source, result.weather_days),
         timezone=result.timezone,
-        box=box(result.max_box_temperature_c, result.minutes_above_product_limit),
+        box=box(
+            result.max_box_temperature_c,
+            result.minutes_above_product_limit,
+            result.product_limit_c,
+        ),
         solver=SolverOut(
             status=result.solved.status,
             objective=result.objective,
@@ -91,12 +99,22 @@ def plan_response(result: PlanResult, include_geometry: bool = False) -> PlanRes
         distance_source=result.distance_source,
         warnings=result.warnings,
         attribution=attribution(result.distance_source),
+        profile=day_profile(result.profile) if include_profile else None,
+    )
+
+
+def day_profile(profile: DayProfile) -> DayProfileOut:
+    return DayProfileOut(
+        time=profile.time,
+        soc=profile.soc,
+        energy_kwh=EnergySeries(**profile.energy_kwh),
+        box_temperature_c=profile.box_temperature_c,
     )
 
 
 def answer(request: PlanRequest, result: PlanResult) -> PlanResponse:
     """What the endpoint answers a plan request with (as JSON)."""
-    return plan_response(result, request.include_geometry)
+    return plan_response(result, request.include_geometry, request.include_profile)
 
 
 def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> PlanFeatureCollection:

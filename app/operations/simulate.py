@@ -6,6 +6,7 @@ import numpy as np
 
 from app import connectors
 from app.operations.answers import battery, box, energy, weather
+from app.operations.vans import van_of
 from app.schemas.base import ConsumptionWhPerKm, PowerSeries
 from app.schemas.simulate import Series, SimulateRequest, SimulateResponse
 from app.settings import Settings
@@ -21,7 +22,7 @@ MIN_DISTANCE_FOR_PER_KM_M = 1.0
 
 def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResponse:
     """Energy of one speed trace, sent or generated (``POST /v1/simulate``)."""
-    van = request.van()
+    van = van_of(request, settings)
     if request.cycle is not None:
         cycle = request.cycle
         street = STREET_TYPES[cycle.street_type]
@@ -91,6 +92,7 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
         box=box(
             result.box.max_temperature_c if dynamic else None,
             result.box.minutes_above_limit if dynamic else None,
+            van.cargo_box.product_limit_c,
         ),
         series=series,
         grid_kwh=result.grid_kwh,

@@ -7,6 +7,7 @@ import datetime as dt
 from app import connectors
 from app.operations.answers import energy
 from app.operations.plan import check_plan, plan_problem
+from app.operations.vans import van_of
 from app.schemas.base import ConsumptionWhPerKm
 from app.schemas.studies import (
     ScenarioCellOut,
@@ -39,6 +40,7 @@ def sweep_start(request: SpeedSweepRequest, settings: Settings) -> dt.datetime:
 def check_sweep(request: SpeedSweepRequest, settings: Settings) -> None:
     """Everything but the sweep itself: what a job refuses at submission."""
     sweep_start(request, settings)
+    van_of(request, settings)
 
 
 def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepResponse:
@@ -59,7 +61,7 @@ def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepRe
             request.distance_m,
             start,
             request.location,
-            request.van(),
+            van_of(request, settings),
             request.weather,
             request.driver_aggressiveness,
             request.traffic_density,

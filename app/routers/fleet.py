@@ -8,7 +8,7 @@ from fastapi import APIRouter, Body, Request
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import FLEET_PLAN_EXAMPLE
-from app.operations.fleet_plan import fleet_response, run_fleet_plan
+from app.operations.fleet_plan import answer, run_fleet_plan
 from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
 
 router = APIRouter(tags=["fleet"])
@@ -44,4 +44,4 @@ async def create_fleet_plan(
     `unassigned` with their reason. Solved in a worker process, as plans are."""
     result = await pool.run(run_fleet_plan, request, settings, disconnected=http.is_disconnected)
     http.app.state.metrics.solve.observe(result.runtime_s)
-    return fleet_response(result, request.include_geometry)
+    return answer(request, result)

@@ -155,9 +155,18 @@ JobId = Annotated[str, Path(max_length=64, description="The job's id.")]
     summary="A job's state and result",
     responses={404: {"description": "No such job (or it expired)."}},
 )
-async def get_job(job_id: JobId, store: StoreDep) -> JobOut:
-    """Its status and timestamps; its result when it succeeded, its error when it failed."""
-    return _out(await asyncio.to_thread(_get, store, job_id))
+async def get_job(
+    job_id: JobId,
+    store: StoreDep,
+    include_request: Annotated[
+        bool, Query(description="Also return the request as it was submitted.")
+    ] = False,
+) -> JobOut:
+    """Its status and timestamps; its result when it succeeded, its error when it failed; with
+    `include_request`, what was submitted (the plan viewer reopens a job's plan with it)."""
+    job = await asyncio.to_thread(_get, store, job_id)
+    out = _out(job)
+    return out.model_copy(update={"request": job.request}) if include_request else out
 
 
 @router.delete(

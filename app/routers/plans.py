@@ -9,7 +9,7 @@ from fastapi.responses import JSONResponse
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import CHARGING_PLAN_EXAMPLE, EN_ROUTE_CHARGING_EXAMPLE, PLAN_EXAMPLE
-from app.operations.plan import plan_geojson, plan_response, run_plan
+from app.operations.plan import answer, plan_geojson, run_plan
 from app.schemas.plans import PlanRequest, PlanResponse
 
 router = APIRouter(tags=["plans"])
@@ -89,4 +89,4 @@ async def create_plan(
     if wants_geojson(accept):
         collection = plan_geojson(result, request.depot.lat, request.depot.lon)
         return JSONResponse(collection.model_dump(mode="json"), media_type=GEOJSON)
-    return plan_response(result, request.include_geometry)
+    return answer(request, result)

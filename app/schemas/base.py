@@ -24,7 +24,6 @@ from core.params import (
     BatteryParams,
     CargoBoxParams,
     Params,
-    Preset,
     VanParams,
     VehicleParams,
     few_unknown,
@@ -107,6 +106,10 @@ def _overrides(name: str, params: type[Params], doc: str, **extra: Any) -> type[
     return create_model(name, __base__=ApiModel, __doc__=doc, **fields)
 
 
+#: A vehicle profile's name: letters, digits, ``.``, ``_`` and ``-``, as in a URL path.
+ProfileName = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9._-]+$")]
+
+
 if TYPE_CHECKING:  # the request models are built at run time from the core's parameters
     VehicleRequest = ApiModel
     CargoBoxRequest = ApiModel
@@ -122,7 +125,14 @@ else:
                 DEFAULT_PRESET,
                 min_length=1,
                 max_length=64,
-                description="Preset name (GET /v1/presets).",
+                description="Preset name (GET /v1/presets); not with `profile`.",
+            ),
+        ),
+        profile=(
+            absent_or(ProfileName),
+            absent(
+                "A vehicle profile's name (GET /v1/vehicle-profiles) to start from instead of "
+                "a preset; the fields beside it change it for this request only."
             ),
         ),
     )
@@ -156,26 +166,46 @@ class VanRequest(ApiModel):
         f"{VanParams.model_fields['precondition_at_depot'].description} Preset value if absent."
     )
 
-    def van(self) -> VanParams:
-        """The preset with this request's changes applied, validated by the core models; an
-        error names the request section (``cargo_box.setpoint_c``)."""
-        try:
-            preset: Preset = get_preset(getattr(self.vehicle, "preset"))  # noqa: B009
-        except InvalidParameterError as error:
-            raise InvalidParameterError(error.message, "vehicle.preset") from None
+    def profile(self) -> str | None:
+        """The vehicle profile this van starts from (``vehicle.profile``), if any; a preset
+        named beside it is a 422."""
+        name: str | None = getattr(self.vehicle, "profile")  # noqa: B009
+        if name is not None and "preset" in self.vehicle.model_fields_set:
+            raise InvalidParameterError("give a preset or a profile, not both", "vehicle.preset")
+        return name
+
+    def van(self, profile: VanParams | None = None) -> VanParams:
+        """The preset — or ``profile``, the parameters this request starts from otherwise
+        (``vehicle.profile``, read by the app from its database) — with this request's
+        changes applied, validated by the core models; an error names the request section
+        (``cargo_box.setpoint_c``)."""
+        if profile is None:
+            if self.profile() is not None:
+                raise TypeError("a request that names vehicle.profile is built on that profile")
+            try:
+                profile = get_preset(getattr(self.vehicle, "preset"))  # noqa: B009
+            except InvalidParameterError as error:
+                raise InvalidParameterError(error.message, "vehicle.preset") from None
+        return self._changed(profile)
+
+    def _changed(self, base: VanParams) -> VanParams:
         sections = {
-            "vehicle": (VehicleParams, preset.vehicle),
-            "cargo_box": (CargoBoxParams, preset.cargo_box),
-            "battery": (BatteryParams, preset.battery),
+            "vehicle": (VehicleParams, base.vehicle),
+            "cargo_box": (CargoBoxParams, base.cargo_box),
+            "battery": (BatteryParams, base.battery),
         }
         built: dict[str, Any] = {}
         details: list[tuple[str, str]] = []
-        for section, (model, base) in sections.items():
+        for section, (model, current) in sections.items():
             changes: ApiModel = getattr(self, section)
-            wanted = {k: getattr(changes, k) for k in changes.model_fields_set if k != "preset"}
+            wanted = {
+                k: getattr(changes, k)
+                for k in changes.model_fields_set
+                if k not in ("preset", "profile")
+            }
             try:
                 with inside_validation():  # pydantic's own errors, one per field
-                    built[section] = model(**(base.model_dump() | wanted))
+                    built[section] = model(**(current.model_dump() | wanted))
             except ValidationError as error:
                 for item in error.errors():
                     path = field_path(item["loc"])
@@ -183,9 +213,9 @@ class VanRequest(ApiModel):
         if details:
             message = "; ".join(f"{field}: {rule}" for field, rule in details)
             raise InvalidParameterError(message, details[0][0], details)
-        payload = preset.payload_kg if self.payload_kg is None else self.payload_kg
+        payload = base.payload_kg if self.payload_kg is None else self.payload_kg
         precondition = (
-            preset.precondition_at_depot
+            base.precondition_at_depot
             if self.precondition_at_depot is None
             else self.precondition_at_depot
         )
@@ -217,6 +247,7 @@ if TYPE_CHECKING:  # built at run time from the consumers
     EnergyKwh = ApiModel
     EnergyShare = ApiModel
     PowerSeries = ApiModel
+    EnergySeries = ApiModel
     ConsumptionWhPerKm = ApiModel
 else:
     EnergyKwh = _per_consumer(
@@ -234,6 +265,13 @@ else:
         "Mean power of each consumer over the step ending at each sample [W] (0 at the start).",
         list[float],
         "W",
+    )
+    EnergySeries = _per_consumer(
+        "EnergySeries",
+        "Energy of each consumer since departure at each moment [kWh].",
+        list[float],
+        "kWh",
+        "Sum of the consumers",
     )
     ConsumptionWhPerKm = _per_consumer(
         "ConsumptionWhPerKm",
@@ -267,6 +305,9 @@ class BatteryOut(ApiModel):
         ..., description="True when the state of charge never falls below the reserve (min_soc)."
     )
     min_soc: float = Field(..., description="Lowest state of charge [–].")
+    reserve_soc: float | None = Field(
+        None, description="The reserve the battery was held to: battery.min_soc [–]."
+    )
     final_soc: float = Field(..., description="State of charge at the end [–].")
     margin_kwh: float = Field(..., description="Energy above the reserve at the lowest point.")
     required_capacity_kwh: float = Field(..., description="Smallest usable capacity that works.")
@@ -322,6 +363,9 @@ class BoxOut(ApiModel):
         ...,
         description="Time with the cargo air above the product limit [min] (dynamic box; "
         "null in steady mode).",
+    )
+    product_limit_c: float | None = Field(
+        None, description="The product's limit the box is held to: cargo_box.product_limit_c [°C]."
     )
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pydantic import Field
 
 from app.schemas.base import ApiModel, AttributionOut, DistanceSourceOut, EnergyKwh, VanRequest
-from app.schemas.plans import GeometryOption, PlanResponse
+from app.schemas.plans import AnswerOptions, PlanResponse
 from core.params import Objective
 from core.planning.model import FleetFields, ShiftFields, UnassignedReason, vehicles_field
 from core.routing.tsp import SolverStatus
@@ -16,7 +16,7 @@ class FleetVehicleRequest(VanRequest, ShiftFields):
     change) and its driver's shift."""
 
 
-class FleetPlanRequest(GeometryOption, FleetFields):
+class FleetPlanRequest(AnswerOptions, FleetFields):
     """The day's stops and the fleet that serves them from one depot."""
 
     vehicles: list[FleetVehicleRequest] = vehicles_field()  # type: ignore[assignment]

@@ -14,6 +14,7 @@ from app.schemas.base import (
     BoxOut,
     DistanceSourceOut,
     EnergyKwh,
+    EnergySeries,
     EnergyShare,
     LineString,
     Point,
@@ -25,17 +26,23 @@ from core.planning.model import PlanFields
 from core.routing.tsp import SolverStatus
 
 
-class GeometryOption(ApiModel):
-    """Whether the answer carries each leg's road."""
+class AnswerOptions(ApiModel):
+    """What the answer carries beyond the legs and stops: each leg's road, the day minute by
+    minute."""
 
     include_geometry: bool = Field(
         False,
         description="Return each leg's road as a GeoJSON LineString in legs[].geometry (the "
         "router's road with OSRM, else the straight line).",
     )
+    include_profile: bool = Field(
+        False,
+        description="Return the day minute by minute in profile: the state of charge, the "
+        "energy of each consumer so far and the box's temperature (the plan viewer's charts).",
+    )
 
 
-class PlanRequest(VanRequest, GeometryOption, PlanFields):
+class PlanRequest(VanRequest, AnswerOptions, PlanFields):
     """A delivery round to plan: depot, stops, date, van and conditions. Stops with
     time_windows are served inside them (the van waits when early); when no order can, the
     answer is a 422 naming the stop that cannot be reached in time."""
@@ -167,6 +174,21 @@ class SolverOut(ApiModel):
     runtime_s: float = Field(..., description="Time the tour search took [s].")
 
 
+class DayProfileOut(ApiModel):
+    """The round minute by minute, from departure to return (the paper's Fig. 8)."""
+
+    time: list[dt.datetime] = Field(..., description="Each minute, local time with UTC offset.")
+    soc: list[float] = Field(..., description="State of charge at each moment [–].")
+    energy_kwh: EnergySeries = Field(
+        ..., description="Energy of each consumer since departure, cumulative [kWh]."
+    )
+    box_temperature_c: list[float] | None = Field(
+        ...,
+        description="Cargo-air temperature at each moment [°C] (dynamic box; null in steady "
+        "mode, where the unit holds the set-point).",
+    )
+
+
 class PlanResponse(ApiModel):
     """The planned and simulated round."""
 
@@ -202,6 +224,9 @@ class PlanResponse(ApiModel):
         "the climatology was used).",
     )
     attribution: AttributionOut = None
+    profile: DayProfileOut | None = Field(
+        None, description="The day minute by minute; present when the request sets include_profile."
+    )
 
 
 class Feature(ApiModel):

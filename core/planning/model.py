@@ -426,7 +426,8 @@ class BreakResult:
 
 @dataclass(frozen=True)
 class DayProfile:
-    """Cumulative energy per consumer over the clock time of the round (paper Fig. 8).
+    """The round minute by minute: cumulative energy per consumer over the clock time (paper
+    Fig. 8), the state of charge and the cargo air's temperature.
 
     Attributes
     ----------
@@ -434,10 +435,17 @@ class DayProfile:
         Moments every minute from departure to return, local time.
     energy_kwh
         Energy used since departure at each moment, per consumer and ``total`` [kWh].
+    soc
+        State of charge at each moment [–].
+    box_temperature_c
+        Cargo-air temperature at each moment [°C]; None for a steady box (held at its
+        set-point).
     """
 
     time: list[dt.datetime]
     energy_kwh: dict[str, list[float]]
+    soc: list[float]
+    box_temperature_c: list[float] | None
 
 
 @dataclass(frozen=True)
@@ -467,6 +475,7 @@ class PlanResult:
     first_infeasible_leg: int | None
     max_box_temperature_c: float | None
     minutes_above_product_limit: float | None
+    product_limit_c: float
     weather: Weather
     weather_days: list[DayWeather]
     weather_source: WeatherSource

@@ -259,7 +259,16 @@ class _Split:
         picks = np.unique(np.append(np.arange(0, size, every), size - 1))
         kwh = {name: (c[picks] / JOULES_PER_KWH).tolist() for name, c in self.cumulative_j.items()}
         kwh["total"] = np.sum([kwh[name] for name in CONSUMERS], axis=0).tolist()
-        return DayProfile([self.moment(int(i)) for i in picks], kwh)
+        box: list[float] | None = None
+        if self.problem.van.cargo_box.mode == "dynamic":
+            # the box's temperature is at the end of each step: sample i ends step i - 1
+            box = self.simulated.box.temperature_c[np.maximum(picks - 1, 0)].tolist()
+        return DayProfile(
+            [self.moment(int(i)) for i in picks],
+            kwh,
+            soc=self.simulated.soc[picks].tolist(),
+            box_temperature_c=box,
+        )
 
     def result(self, solved: Solved, warnings: list[str]) -> PlanResult:
         simulated, places, legs = self.simulated, self.scene.places, self.scene.legs
@@ -288,6 +297,7 @@ class _Split:
             ),
             max_box_temperature_c=simulated.box.max_temperature_c if dynamic else None,
             minutes_above_product_limit=simulated.box.minutes_above_limit if dynamic else None,
+            product_limit_c=self.problem.van.cargo_box.product_limit_c,
             weather=simulated.weather,
             weather_days=simulated.weather_days,
             weather_source=simulated.weather_source,

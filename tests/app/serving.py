@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import ctypes
 import os
+import time
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +47,38 @@ def children(pid: int) -> list[int]:
             if parent == pid:
                 found.append(int(entry.name))
     return found
+
+
+def cpu_ticks(pids: list[int], window_s: float = 1.0) -> dict[int, int]:
+    """CPU clock ticks (user + system, 1/100 s) each process used over the same ``window_s``;
+    a process that ended meanwhile is left out."""
+
+    def ticks(pid: int) -> int:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return int(fields[11]) + int(fields[12])
+
+    before = {}
+    for pid in pids:
+        try:
+            before[pid] = ticks(pid)
+        except (OSError, IndexError):
+            continue
+    time.sleep(window_s)
+    used = {}
+    for pid, start in before.items():
+        try:
+            used[pid] = ticks(pid) - start
+        except (OSError, IndexError):
+            continue
+    return used
+
+
+def busiest_child(pid: int, window_s: float = 1.0) -> int | None:
+    """The child of ``pid`` that used the most CPU over ``window_s`` (the worker that solves,
+    however loaded the machine is), or None when none used any."""
+    used = cpu_ticks(children(pid), window_s)
+    busiest = max(used, key=used.__getitem__, default=None)
+    return busiest if busiest is not None and used[busiest] > 0 else None
 
 
 def alive(pid: int) -> bool:

@@ -4,11 +4,14 @@ refused — the docs must work without internet."""
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import httpx
 import pytest
-from playwright.sync_api import sync_playwright
+from playwright.sync_api import Page, sync_playwright
 
 from benchmarks.common import Server
 
@@ -32,24 +35,34 @@ def server():
     started.close()
 
 
-@pytest.fixture
-def page(server):
+@contextlib.contextmanager
+def offline_tab(url: str, **context: Any) -> Iterator[tuple[Page, list[str], list[str]]]:
+    """A Chromium tab on the service at ``url`` whose requests to any other host are refused
+    and listed; with the errors its scripts threw."""
     outside: list[str] = []
+    errors: list[str] = []
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
-        context = browser.new_context(viewport={"width": 1400, "height": 1000})
-        opened = context.new_page()
+        options = {"viewport": {"width": 1400, "height": 1000}} | context
+        opened = browser.new_context(**options).new_page()
+        opened.on("pageerror", lambda error: errors.append(str(error)))
 
         def offline(route):
-            if route.request.url.startswith(server.url):
+            if route.request.url.startswith(url):
                 route.continue_()
             else:
                 outside.append(route.request.url)
                 route.abort()
 
         opened.route("**/*", offline)
-        yield opened, outside
+        yield opened, outside, errors
         browser.close()
+
+
+@pytest.fixture
+def page(server):
+    with offline_tab(server.url) as (opened, outside, _):
+        yield opened, outside
 
 
 def test_swagger_ui_works_offline_and_try_it_out_plans_a_round(server, page):

@@ -44,7 +44,7 @@ def test_every_phase_and_check_passes():
                 "--exclude-checks",
                 "use_after_free",
                 "--max-examples",
-                os.environ.get("COLDROUTE_CONTRACT_EXAMPLES", "15"),
+                os.environ.get("COLDROUTE_CONTRACT_EXAMPLES", "10"),
                 "--header",
                 f"X-API-Key: {KEY}",
                 "--generation-deterministic",

@@ -1,4 +1,6 @@
 import copy
+import datetime as dt
+import itertools
 
 import pytest
 
@@ -142,3 +144,33 @@ def test_oversized_body_is_413(client):
 def test_time_limit_is_capped_by_the_server(client):
     body = client.post("/v1/plans", json=PLAN_EXAMPLE | {"time_limit_s": 500}).json()
     assert body["solver"]["runtime_s"] < 0.5 + 0.2
+
+
+def test_the_day_profile_is_the_simulation_minute_by_minute(client):
+    """include_profile: a point a minute from departure to return, the state of charge of the
+    legs at their ends, the energy summed to the totals, the dynamic box's temperature."""
+    body = copy.deepcopy(PLAN_EXAMPLE) | {"include_profile": True}
+    body["vehicle"] = {"preset": "ev-van-3.5t-reefer"}  # a dynamic box
+    body["battery"] = {"min_soc": 0.12}
+    answer = client.post("/v1/plans", json=body).json()
+    profile = answer["profile"]
+    times = [dt.datetime.fromisoformat(t) for t in profile["time"]]
+    assert times[0] == dt.datetime.fromisoformat(answer["legs"][0]["depart"])
+    assert times[-1] == dt.datetime.fromisoformat(answer["legs"][-1]["arrive"])
+    steps = {b - a for a, b in itertools.pairwise(times[:-1])}
+    assert steps == {dt.timedelta(minutes=1)}
+    assert len(profile["soc"]) == len(profile["box_temperature_c"]) == len(times)
+    assert profile["soc"][0] == pytest.approx(answer["legs"][0]["soc_start"])
+    assert profile["soc"][-1] == pytest.approx(answer["battery"]["final_soc"])
+    assert min(profile["soc"]) == pytest.approx(answer["battery"]["min_soc"], abs=2e-3)
+    for consumer, total in answer["totals"]["energy_kwh"].items():
+        assert profile["energy_kwh"][consumer][-1] == pytest.approx(total, rel=1e-6)
+    for consumer in ("auxiliaries", "cabin", "refrigeration"):  # traction regenerates
+        series = profile["energy_kwh"][consumer]
+        assert all(b >= a - 1e-12 for a, b in itertools.pairwise(series))
+    assert max(profile["box_temperature_c"]) == pytest.approx(
+        answer["box"]["max_temperature_c"], abs=0.05
+    )
+    assert answer["battery"]["reserve_soc"] == 0.12
+    assert answer["box"]["product_limit_c"] == 7.0
+    assert client.post("/v1/plans", json=PLAN_EXAMPLE).json()["profile"] is None

@@ -142,7 +142,7 @@ def test_sigterm_answers_503_to_what_outlasts_the_grace(server):
     workers = children(server.process.pid)
     with concurrent.futures.ThreadPoolExecutor(1) as pool:
         running = pool.submit(post, server.url, long_plan(300, 8))
-        time.sleep(1.0)
+        wait_until(server.url, "1 busy")  # solving, not on its way in (a loaded machine)
         signalled = time.monotonic()
         server.process.send_signal(signal.SIGTERM)
         late = running.result()

@@ -1,10 +1,10 @@
-"""Alembic environment: upgrades the connection the job store hands over."""
+"""Alembic environment: upgrades the connection the database hands over."""
 
 from __future__ import annotations
 
 from alembic import context
 
-from app.jobs.models import Base
+from app.database import Base
 
 connection = context.config.attributes["connection"]
 context.configure(connection=connection, target_metadata=Base.metadata, render_as_batch=True)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import sqlalchemy as sa
 from alembic import op
 
-from app.jobs.models import UtcDateTime
+from app.database import UtcDateTime
 
 revision = "0002"
 down_revision = "0001"
