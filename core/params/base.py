@@ -32,7 +32,7 @@ from core.exceptions import InvalidParameterError
 #: pydantic's own parsers also take other scripts' digits, a time of day after a date, numbers).
 DATE_PATTERN = r"^[0-9]{4}-[0-9]{2}-[0-9]{2}$"
 DATETIME_PATTERN = (
-    r"^[0-9]{4}-[0-9]{2}-[0-9]{2}[Tt ][0-9]{2}:[0-9]{2}(:[0-9]{2}([.,][0-9]{1,9})?)?"
+    r"^[0-9]{4}-[0-9]{2}-[0-9]{2}[Tt ][0-9]{2}:[0-9]{2}(:[0-9]{2}([.,][0-9]{1,6})?)?"
     r"([Zz]|[+-][0-9]{2}:?[0-9]{2})$"
 )
 
@@ -46,6 +46,10 @@ def _iso_text(pattern: str, example: str) -> Any:
             return value
         if isinstance(value, str) and re.fullmatch(pattern, value):
             return value
+        if isinstance(value, str) and re.search(r":[0-9]{2}[.,][0-9]{7,}", value):
+            raise ValueError(
+                "at most 6 digits after the seconds (microseconds): a finer instant would be cut"
+            )
         raise ValueError(f"expected ISO 8601 text like {example}")
 
     return BeforeValidator(check)

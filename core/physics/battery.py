@@ -55,15 +55,21 @@ def battery_energy_j(
 class BatteryVerdict:
     """Whether the battery holds out with its reserve.
 
+    Every figure comes from one state-of-charge series, never clipped: below 0 it is the
+    energy the battery does not hold, as a share of its usable capacity (the van would stop
+    there). So ``feasible`` ⇔ ``min_soc ≥ reserve_soc`` ⇔ ``margin_kwh ≥ 0``, whatever the
+    reserve (an empty battery is never feasible, even with ``min_soc = 0``).
+
     Attributes
     ----------
     feasible
         True when the state of charge never falls below ``min_soc``.
     min_soc, final_soc
-        Lowest and last state of charge [–].
+        Lowest and last state of charge [–]; negative when the battery would run empty.
     margin_kwh
-        Energy left above the reserve at the lowest point [kWh]; negative when infeasible
-        (the shortfall, even beyond an empty battery).
+        Energy left above the reserve at the lowest point [kWh]:
+        ``(min_soc − reserve_soc) · usable_capacity_kwh``; negative when infeasible (the
+        shortfall, even beyond an empty battery).
     required_capacity_kwh
         Smallest nominal usable capacity that keeps the same trace above the reserve [kWh].
     usable_capacity_kwh
@@ -87,6 +93,10 @@ class BatteryVerdict:
     reserve_soc: float
 
 
+#: How far below the reserve a state of charge may round and still hold it [–]: float noise.
+SOC_TOLERANCE = 1e-12
+
+
 def discharge(
     battery: BatteryParams, step_energy_j: ArrayLike, usable_share: float = 1.0
 ) -> tuple[FloatArray, BatteryVerdict]:
@@ -94,8 +104,9 @@ def discharge(
     step [J].
 
     ``soc_k = min(1, soc_{k−1} − E_k / C)``: regeneration charges the battery but not beyond
-    full. ``C`` is the usable capacity times ``usable_share`` (:func:`capacity_factor`). The
-    state of charge has ``n + 1`` values for ``n`` steps, the first being ``initial_soc``.
+    full; nothing stops it at empty (a negative state of charge is energy the battery lacks).
+    ``C`` is the usable capacity times ``usable_share`` (:func:`capacity_factor`). The state
+    of charge has ``n + 1`` values for ``n`` steps, the first being ``initial_soc``.
 
     The required capacity is the deepest discharge below any earlier peak (regeneration cannot
     lift a full battery) divided by the usable window ``initial_soc − min_soc`` and by the
@@ -108,17 +119,16 @@ def discharge(
     lowest_used = np.minimum.accumulate(used_kwh) if used_kwh.size else used_kwh
     headroom_kwh = (1.0 - battery.initial_soc) * capacity_kwh
     depth_kwh = used_kwh - np.minimum(lowest_used, -headroom_kwh)
-    # Below empty the van would stop: the charge shows 0, the margin tells the shortfall.
-    uncapped = np.concatenate(([battery.initial_soc], 1.0 - depth_kwh / capacity_kwh))
-    soc = np.maximum(uncapped, 0.0)
+    soc = np.concatenate(([battery.initial_soc], 1.0 - depth_kwh / capacity_kwh))
     drawdown_kwh = used_kwh - np.minimum(lowest_used, 0.0)
     peak_draw_kwh = float(drawdown_kwh.max()) if drawdown_kwh.size else 0.0
-    below = np.flatnonzero(soc < battery.min_soc - 1e-12)
+    below = np.flatnonzero(soc < battery.min_soc - SOC_TOLERANCE)
+    lowest = float(soc.min())
     return soc, BatteryVerdict(
         feasible=below.size == 0,
-        min_soc=float(soc.min()),
+        min_soc=lowest,
         final_soc=float(soc[-1]),
-        margin_kwh=(float(uncapped.min()) - battery.min_soc) * capacity_kwh,
+        margin_kwh=(lowest - battery.min_soc) * capacity_kwh,
         required_capacity_kwh=peak_draw_kwh
         / (battery.initial_soc - battery.min_soc)
         / usable_share,

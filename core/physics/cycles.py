@@ -162,6 +162,11 @@ def stretch_to_duration(speed_mps: FloatArray, dt_s: float, duration_s: float) -
     return stretched * (distance / total) if total > 0 else stretched
 
 
+#: How much steeper than the van's acceleration a sampled ramp may come out [–]: sampling a
+#: trapezoid's corners on whole steps and scaling it to its distance adds up to a few per cent.
+RAMP_TOLERANCE = 0.05
+
+
 def rest_to_rest(
     distance_m: float, duration_s: float, accel_mps2: float, top_mps: float, dt_s: float = 1.0
 ) -> FloatArray:
@@ -170,7 +175,10 @@ def rest_to_rest(
     for a van that accelerates so and tops out at ``top_mps``, in the least time it can.
 
     The cruising speed solves ``d = v·(T − v/a)``: ``v = (a·T − √(a²T² − 4·a·d))/2``; the least
-    time is ``2·√(d/a)`` (no cruise) or ``d/v_top + v_top/a``.
+    time is ``2·√(d/a)`` (no cruise) or ``d/v_top + v_top/a``. The trace starts and ends at
+    rest on whole steps (at least two) and covers exactly ``distance_m``: where sampling the
+    shape on ``dt_s`` and scaling it to the distance would ask for more than ``top_mps`` or
+    clearly more than ``accel_mps2`` (:data:`RAMP_TOLERANCE`), it takes a step longer.
 
     Parameters
     ----------
@@ -179,16 +187,28 @@ def rest_to_rest(
     accel_mps2, top_mps
         The van's acceleration (and deceleration) [m/s²] and top speed [m/s].
     """
+    if distance_m <= 0:
+        return np.zeros(max(round(duration_s / dt_s), 0) + 1)
     least_s = fastest_s(distance_m, accel_mps2, top_mps)
-    total_s = max(duration_s, least_s)
+    steps = max(math.ceil(max(duration_s, least_s) / dt_s - 1e-9), 2)
+    while True:
+        trace = _trapezoid(distance_m, steps * dt_s, accel_mps2, dt_s)
+        steepest = float(np.abs(np.diff(trace)).max()) / dt_s
+        if trace.max() <= top_mps and steepest <= accel_mps2 * (1 + RAMP_TOLERANCE):
+            return trace
+        steps += 1
+
+
+def _trapezoid(distance_m: float, total_s: float, accel_mps2: float, dt_s: float) -> FloatArray:
+    """Accelerate, cruise, brake over ``total_s`` (a whole number of ``dt_s``, no less than
+    the least time), sampled every ``dt_s`` and scaled to cover ``distance_m`` exactly."""
     a = accel_mps2
     cruise = (a * total_s - math.sqrt(max(a * a * total_s * total_s - 4 * a * distance_m, 0.0))) / 2
     ramp_s = cruise / a
     times = np.array([0.0, ramp_s, total_s - ramp_s, total_s])
-    grid = np.arange(0.0, total_s + dt_s / 2, dt_s)
+    grid = np.arange(round(total_s / dt_s) + 1) * dt_s
     trace = np.interp(grid, times, np.array([0.0, cruise, cruise, 0.0]))
-    covered = trace_distance_m(trace, dt_s)
-    return trace * (distance_m / covered) if covered > 0 else trace
+    return trace * (distance_m / trace_distance_m(trace, dt_s))
 
 
 def fastest_s(distance_m: float, accel_mps2: float, top_mps: float) -> float:

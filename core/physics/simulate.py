@@ -56,6 +56,8 @@ CONSUMERS: dict[str, str] = {
 MAX_SPEED_MPS = 250 / 3.6
 #: Steepest grade accepted [–] (the steepest public streets are about 0.35).
 MAX_ABS_GRADE = 0.5
+#: Heaviest payload accepted [kg] (a 40 t articulated lorry's gross mass).
+MAX_PAYLOAD_KG = 40_000.0
 _EPOCH_DATE = dt.date(1970, 1, 1)
 
 
@@ -97,6 +99,10 @@ class SimulationResult:
         What the simulation had to change (a motor's cap the trace asked too much of).
     charges
         What each charging spell did, in the order given.
+    asked_s
+        For each sample, the moment of the trace asked for at the same place [s], when the
+        motor's cap made the van drive it slower (:func:`core.physics.motor.power_limited`);
+        None when it drove the trace as asked.
     """
 
     time_s: FloatArray
@@ -116,6 +122,14 @@ class SimulationResult:
     weather_source: WeatherSource
     warnings: list[str]
     charges: list[ChargeOutcome] = field(default_factory=list)
+    asked_s: FloatArray | None = None
+
+    def sample_at(self, asked_sample: ArrayLike) -> Any:
+        """The sample that the van drove at the place of a sample of the trace asked for."""
+        if self.asked_s is None:
+            return asked_sample
+        moment_s = np.asarray(asked_sample, dtype=float) * (self.time_s[1] - self.time_s[0])
+        return np.rint(np.interp(moment_s, self.asked_s, np.arange(self.time_s.size))).astype(int)
 
 
 @dataclass(frozen=True)
@@ -287,6 +301,7 @@ def simulate(
         weather_source=outside.source,
         warnings=trace.warnings,
         charges=charges,
+        asked_s=trace.asked_s,
     )
 
 
@@ -302,6 +317,7 @@ class _Trace:
     parked: Sequence[Interval]
     warnings: list[str]
     charging: Sequence[ChargingSpell] = ()
+    asked_s: FloatArray | None = None
 
 
 def _driven(
@@ -323,7 +339,7 @@ def _driven(
     n = speed.size
     payload = van.payload_kg if payload_kg is None else payload_kg
     grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
-    payload_step = _per_step(payload, n, "payload_kg", 0.0, 40_000.0)
+    payload_step = _per_step(payload, n, "payload_kg", 0.0, MAX_PAYLOAD_KG)
     _check_within((n - 1) * dt_s, door_openings=door_openings, parked=parked, charging=charging)
     retimed = power_limited(
         van.vehicle, speed, dt_s, van.vehicle.mass_kg + payload_step, grade_step
@@ -350,7 +366,7 @@ def _driven(
     return _Trace(
         retimed.speed_mps,
         _per_step(linear(grade), m, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE),
-        _per_step(stepwise(payload), m, "payload_kg", 0.0, 40_000.0),
+        _per_step(stepwise(payload), m, "payload_kg", 0.0, MAX_PAYLOAD_KG),
         None if heading_deg is None else stepwise(heading_deg),
         [moved(d) for d in door_openings],
         [moved(p) for p in parked],
@@ -359,6 +375,7 @@ def _driven(
             f"{retimed.lost_s:,.0f} s slower (the same distance, the energy delivered later)"
         ],
         [moved(c) for c in charging],
+        retimed.original_s,
     )
 
 
@@ -423,15 +440,16 @@ def _battery(
         last = min(round((spell.start_s + spell.duration_s) / dt_s), drawn_j.size)
         grid_loads_j = float(consumer_j[first:last].sum())
         drawn_j[first:last] = 0.0
-        before = battery_model.discharge(van.battery, drawn_j[:first], usable_share)[0][-1]
+        before = float(battery_model.discharge(van.battery, drawn_j[:first], usable_share)[0][-1])
         curve = charge_curve(van.battery, spell.power_kw * WATTS_PER_KW, usable_share)
-        reached = curve.soc_after(float(before), np.arange(0, last - first + 1) * dt_s)
+        # A battery run below empty (infeasible already) charges from empty; its shortfall stays.
+        reached = curve.soc_after(max(before, 0.0), np.arange(0, last - first + 1) * dt_s)
         drawn_j[first:last] = -np.diff(reached) * curve.capacity_j
         stored_j = float((reached[-1] - reached[0]) * curve.capacity_j)
         charges.append(
             ChargeOutcome(
-                soc_before=float(before),
-                soc_after=float(reached[-1]),
+                soc_before=before,
+                soc_after=before + float(reached[-1] - reached[0]),
                 stored_j=stored_j,
                 charge_grid_j=stored_j / van.battery.charging_efficiency,
                 consumers_grid_j=grid_loads_j,
@@ -439,8 +457,10 @@ def _battery(
         )
     soc, verdict = battery_model.discharge(van.battery, drawn_j, usable_share)
     charged_j = sum(c.stored_j for c in charges)
-    loss_j = (
-        float((drawn_j - consumer_j).sum()) + charged_j + sum(c.consumers_grid_j for c in charges)
+    # Never negative (the derating takes more and stores less); clipped of float noise.
+    loss_j = max(
+        float((drawn_j - consumer_j).sum()) + charged_j + sum(c.consumers_grid_j for c in charges),
+        0.0,
     )
     return soc, verdict, loss_j, charges
 

@@ -49,7 +49,14 @@ def explain(
 def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[UnassignedReason, str]:
     """A stop some van could serve on a round of its own, left out because the fleet is full:
     the rule that stops it from joining any van's route at its best place, the one most vans
-    share."""
+    share. A van with no route that would serve it alone has been given it (or its
+    simulation said why not, :func:`core.planning.fleet.search`): the vans without a route
+    refuse it alone, and their reason comes first."""
+    idle = [why for v, route in enumerate(routes) if not route and (why := rules.alone(v, node))]
+    if idle:
+        reason = _most_shared(Counter(why.reason for why in idle))
+        detail = next(why.detail for why in idle if why.reason == reason)
+        return reason, f"the vans without a route cannot serve it on a round of its own: {detail}"
     refusals: Counter[UnassignedReason] = Counter()
     for v, route in enumerate(routes):
         options = [

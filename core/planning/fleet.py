@@ -26,7 +26,7 @@ the full simulation of its day.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -55,7 +55,7 @@ from core.planning.model import (
 from core.planning.repair import Repaired, fitting, repair
 from core.planning.scene import Scene, legs_for, round_field
 from core.planning.solver_input import routing_input
-from core.planning.start_state import START_ID, check_start, under_way
+from core.planning.start_state import START_ID, check_start, check_start_id, under_way
 from core.planning.timeline import client_legs_too_fast, drive_time_s
 from core.planning.verify import Failure, route_failure, traced_seconds
 from core.routing.geo import build_legs
@@ -158,8 +158,23 @@ def plan_fleet(
         verification_rounds=routed.verification_rounds,
         timezone=timezone_name,
         distance_source=legs.source,
-        warnings=day_weather[1],
+        warnings=[*day_weather[1], *routed.warnings, *_payload_short(problem, routed.unassigned)],
     )
+
+
+def _payload_short(problem: FleetProblem, unassigned: list[Unassigned]) -> list[str]:
+    """A warning when stops are left out because the fleet is full: what the vans carry and
+    what the stops take [kg]."""
+    full = [u.id for u in unassigned if u.reason == "capacity"]
+    if not full:
+        return []
+    carried = sum(v.van.payload_kg * v.max_trips for v in problem.vehicles)
+    taken = sum(stop.delivery_kg for stop in problem.stops)
+    return [
+        f"{len(full)} stop{'s' * (len(full) > 1)} left out for payload: the vans carry "
+        f"{carried:,.0f} kg in all (payload_kg × max_trips) and the stops take {taken:,.0f} kg; "
+        "check each van's payload_kg"
+    ]
 
 
 def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
@@ -169,6 +184,9 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
     :class:`core.exceptions.CoreError` naming the field; returns each van's shift (from its
     start state's time when under way) and the zone's name."""
     check_places(problem)
+    moving = next((k for k, v in enumerate(problem.vehicles) if v.start_state is not None), None)
+    if moving is not None:
+        check_start_id(problem, f"vehicles[{moving}].start_state")
     vans: dict[str, int] = {}
     for index, vehicle in enumerate(problem.vehicles):
         if vehicle.id in vans:
@@ -219,12 +237,14 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
 @dataclass(frozen=True)
 class Routed:
     """What a search found: the verified routes, the stops left out, the rounds of
-    verification and the objective's estimated value over the routes."""
+    verification, the objective's estimated value over the routes, and what the answer must
+    say of them (a van under way that cannot reach the depot with its reserve)."""
 
     routes: list[FleetRoute]
     unassigned: list[Unassigned]
     verification_rounds: int
     objective_value: float
+    warnings: list[str] = field(default_factory=list)
 
     def stamped(self, runtime_s: float) -> list[FleetRoute]:
         """The routes with the search's whole run time [s] on each plan."""
@@ -290,6 +310,59 @@ def _repair(day: FleetDay, v: int, route: list[int], failure: Failure) -> Repair
     return repair(route, failure, simulate, check, day.estimates[v])
 
 
+def _short_home(day: FleetDay, v: int, results: dict[int, PlanResult]) -> bool:
+    """Whether van ``v`` is under way and runs below its reserve even on its way home (the
+    one route a fleet reports below its reserve: the van is where it is)."""
+    return bool(day.starts[v]) and v in results and not results[v].battery.feasible
+
+
+def _stranded(day: FleetDay, v: int, result: PlanResult) -> str:
+    shift = day.shifts[v]
+    served = f"with its {len(result.stops)} stops" if result.stops else "with no stop"
+    return (
+        f"{shift.id} is under way with too little charge: {served}, its drive back to the depot "
+        f"takes the battery to {result.battery.min_soc:.0%}, below its reserve of "
+        f"{shift.problem.van.battery.min_soc:.0%} (it needs a charge on the way)"
+    )
+
+
+def _given_to_idle(
+    day: FleetDay, rules: Feasibility, routes: list[list[int]], results: dict[int, PlanResult]
+) -> dict[int, Failure]:
+    """Each stop left out that a van without a route serves on a round of its own goes to
+    that van (``routes`` and ``results`` changed in place): first by the estimates, then by
+    the simulation. No stop stays out for a window or the fleet's being full while an idle
+    van could take it; where the simulation refuses the round of its own, its failure is why
+    (returned by stop). One simulation per stop and kind of idle van."""
+    kinds = [_kind(day, v) for v in day.vans]
+    served = {node for route in routes for node in route}
+    refused: dict[int, Failure] = {}
+    for node in day.stop_nodes:
+        if node in served or node in day.unreachable:
+            continue
+        tried: set[str] = set()
+        for v in day.vans:
+            if routes[v] or kinds[v] in tried or rules.alone(v, node) is not None:
+                continue
+            tried.add(kinds[v])
+            result = day.simulate(v, [node])
+            failure = _failure(day, v, result)
+            if failure is None:
+                routes[v], results[v] = [node], result
+                refused.pop(node, None)
+                break
+            refused[node] = replace(failure, node=node)
+    return refused
+
+
+def _kind(day: FleetDay, v: int) -> str:
+    """What makes van ``v``'s round of its own what it is: the van, its shift, its start."""
+    shift = day.shifts[v]
+    problem = shift.problem
+    rules = (problem.breaks, problem.max_trips, problem.reload_minutes, problem.start_state)
+    return f"{problem.van.model_dump_json()}|{shift.start}|{shift.end}|{day.starts[v]}|{rules}"
+
+
 def search(
     day: FleetDay, minimize_vehicles: bool, deadline: float, charging_until: float | None = None
 ) -> Routed:
@@ -342,6 +415,7 @@ def search(
         else:
             results[v] = repaired.result
     rules = Feasibility(day, times.matrix(), budgets)
+    left_out |= _given_to_idle(day, rules, routes, results)
     served = {node for route in routes for node in route}
     unassigned = [
         explain(rules, node, left_out.get(node), routes)
@@ -356,6 +430,7 @@ def search(
         if day.starts[v] and not routes[v]:
             results[v] = day.simulate(v, [])
     return Routed(
+        warnings=[_stranded(day, v, results[v]) for v in day.vans if _short_home(day, v, results)],
         routes=[
             FleetRoute(day.shifts[v].id, results[v])
             for v in day.vans

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Annotated, Any, Literal
 
-from pydantic import Discriminator, Field, Tag, ValidationInfo, field_validator
+from pydantic import AfterValidator, Discriminator, Field, Tag, ValidationInfo, field_validator
 
 from core.exceptions import InvalidParameterError, InvalidStopsError
 from core.params import (
@@ -141,14 +141,40 @@ class FixedBreak(Params):
         return value
 
 
-#: Drivers' breaks: EU Regulation (EC) No 561/2006 (art. 7), none, or fixed breaks.
+#: Most fixed breaks of one driver's day.
+MAX_FIXED_BREAKS = 12
+
+
 def _break_branch(value: object) -> str:
     return BRANCH_TAG + ("list" if isinstance(value, list) else "rule")
 
 
+def _one_after_another(breaks: list[FixedBreak]) -> list[FixedBreak]:
+    """Fixed breaks a driver can take in their order: each begins by its ``latest`` after the
+    one before it ends (the earliest each can begin, one after another)."""
+    free_min = 0.0
+    for k, rest in enumerate(breaks):
+        earliest = rest.earliest.hour * 60 + rest.earliest.minute
+        latest = rest.latest.hour * 60 + rest.latest.minute
+        begins = max(earliest, free_min)
+        if begins > latest:
+            raise ValueError(
+                f"breaks[{k}] must begin by {rest.latest:%H:%M}, but the breaks before it last "
+                f"until {int(free_min) // 60:02d}:{int(free_min) % 60:02d} at the earliest"
+            )
+        free_min = begins + rest.minutes
+    return breaks
+
+
+#: Drivers' breaks: EU Regulation (EC) No 561/2006 (art. 7), none, or fixed breaks.
 Breaks = Annotated[
     Annotated[Literal["eu-561", "none"], Tag(BRANCH_TAG + "rule")]
-    | Annotated[list[FixedBreak], Tag(BRANCH_TAG + "list")],
+    | Annotated[
+        list[FixedBreak],
+        Field(max_length=MAX_FIXED_BREAKS),
+        AfterValidator(_one_after_another),
+        Tag(BRANCH_TAG + "list"),
+    ],
     Discriminator(_break_branch),
 ]
 

@@ -53,6 +53,8 @@ RETURN_ENERGY_FACTOR = 1.25
 #: Most places to charge simulated for one charge, best estimate first: a charger the
 #: estimate wrongly thought within reach is skipped for the next.
 OPTIONS_TRIED = 3
+#: Longest charge planned [s] (a day): a slower charge is no option, and the answer says so.
+MAX_CHARGE_S = 86_400.0
 
 Roads = Callable[[list[int]], list[LegRoute] | None]
 #: When every point of a charger is taken by other vans, by the charger's place index.
@@ -123,8 +125,27 @@ def with_charges(
             "lets the van reach an open charger with its reserve, and charge there in the time its "
             "later windows leave (no charger within reach)"
         )
-        result = replace(result, warnings=[*result.warnings, warning])
+        result = replace(result, warnings=[*result.warnings, warning, *_too_slow(day, points)])
     return result
+
+
+def _too_slow(day: _Round, points: dict[int, ChargePoint]) -> list[str]:
+    """A warning for each charger at which the van would charge from its reserve to full in
+    more than :data:`MAX_CHARGE_S` (its charging curve, or the charger, too slow)."""
+    reserve = day.problem.van.battery.min_soc
+    warnings = []
+    for place, point in points.items():
+        curve = charge_curve(day.problem.van.battery, point.power_kw * WATTS_PER_KW)
+        hours = curve.time_s(reserve, 1.0) / 3600
+        if hours * 3600 > MAX_CHARGE_S:
+            name = "depot" if place == 0 else f"'{day.scene.places[place].id}'"
+            warnings.append(
+                f"charging at the {name} charger would take {hours:,.0f} h from the reserve to "
+                f"full at {float(curve.power_at_w(reserve)[()]) / 1000:g} kW (the charger's "
+                "power and the van's charging_curve): no charge longer than "
+                f"{MAX_CHARGE_S / 3600:.0f} h is planned"
+            )
+    return warnings
 
 
 def _charged(
@@ -429,15 +450,16 @@ def _charge_options(
             needed = reserve + rest + way_soc(place, onward) + PARTIAL_CHARGE_MARGIN
             curve = day.curve(point, result)
             charge_s = curve.time_s(plugged, min(needed, 1.0))
-            if come_s + wait_s + plug_s + charge_s > hours[1]:
-                continue  # it closes before the charge is done
+            if come_s + wait_s + plug_s + charge_s > hours[1] or charge_s > MAX_CHARGE_S:
+                continue  # it closes before the charge is done, or it charges too slowly
             added_s = detour_s + wait_s + plug_s + charge_s
             if added_s > slack[p + 1]:
                 continue  # a later window or the return would be missed
             if needed > 1.0:  # the rest at another visit like this one
                 rate_w = float(curve.power_at_w(reserve)[()]) * curve.efficiency
                 added_s += (needed - 1.0) * capacity_j / rate_w + detour_s + plug_s
-            visit = ChargeVisit(plug_s, curve.time_s(plugged, 1.0), point.power_kw, open_s)
+            full_s = min(curve.time_s(plugged, 1.0), MAX_CHARGE_S)
+            visit = ChargeVisit(plug_s, full_s, point.power_kw, open_s)
             options.append(_Option(p, place, added_s, visit))
     return sorted(options, key=lambda o: (o.added_s, -o.cut))
 
@@ -460,11 +482,13 @@ def _reload_charge(
     curve = day.curve(point, result)
     plug_s = point.plug_minutes * 60
     wait_s = max(hours[0] - come_s, 0.0)
-    standing_s = wait_s + plug_s + curve.time_s(arriving, needed)
-    if come_s + standing_s > hours[1]:
-        return None  # another van takes the point before the charge is done
+    charge_s = curve.time_s(arriving, needed)
+    standing_s = wait_s + plug_s + charge_s
+    if come_s + standing_s > hours[1] or charge_s > MAX_CHARGE_S:
+        return None  # another van takes the point before the charge is done, or too slow
     added_s = max(standing_s - day.problem.reload_minutes * 60, 0.0)
-    visit = ChargeVisit(plug_s, curve.time_s(arriving, 1.0), point.power_kw, open_s, True)
+    full_s = min(curve.time_s(arriving, 1.0), MAX_CHARGE_S)
+    visit = ChargeVisit(plug_s, full_s, point.power_kw, open_s, True)
     return _Option(p, 0, added_s, visit, inserted=False)
 
 
@@ -531,7 +555,7 @@ def _fitted(
         )
         visit = charges[here]
         curve = charge_curve(battery, visit.power_kw * WATTS_PER_KW, share)
-        fitted[here] = replace(visit, charge_s=curve.time_s(arriving, target))
+        fitted[here] = replace(visit, charge_s=min(curve.time_s(arriving, target), MAX_CHARGE_S))
         leaving = max(arriving, target)
     return fitted
 

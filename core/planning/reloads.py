@@ -27,6 +27,15 @@ def reloads_allowed(problem: PlanProblem) -> bool:
     return problem.max_trips > 1 and not windowed and problem.start_state is None
 
 
+def _why_no_reload(problem: PlanProblem) -> str:
+    """Why a round does not come back to reload, as a dispatcher reads it."""
+    if problem.max_trips == 1:
+        return "with max_trips above 1, a round without time windows comes back to reload"
+    if problem.start_state is not None:
+        return "a round planned from start_state does not come back to reload"
+    return "a round with time windows does not come back to reload"
+
+
 def check_payload(problem: PlanProblem) -> None:
     """What the stops take fits the van: in one load, or with reloads in ``max_trips`` loads
     each stop within one; else an error naming the stops or the stop. In the solver's units,
@@ -39,8 +48,7 @@ def check_payload(problem: PlanProblem) -> None:
         if int(weights.sum()) > capacity:
             raise InvalidStopsError(
                 f"the stops' delivery_kg add up to {delivered:g} kg, more than the payload "
-                f"{payload:g} kg (with max_trips above 1, a round without time windows comes "
-                "back to reload)",
+                f"{payload:g} kg ({_why_no_reload(problem)})",
                 "stops",
             )
         return

@@ -79,7 +79,6 @@ def plan(
     """
     started = time.perf_counter()
     start, timezone_name = check(problem)
-    start = check_start(problem, start.tzinfo) or start
     problem = under_way(problem)
     places = round_places(problem)
     legs = legs_for(problem, router, places)
@@ -222,16 +221,17 @@ def _check_reachable(problem: PlanProblem, places: list[Place], legs: Legs) -> N
 
 
 def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
-    """Everything about a round that can be checked without solving it: unique stop ids, the
-    payload, the time zone and start time, the client's matrix. Raises
-    :class:`core.exceptions.CoreError` naming the field; returns the departure and the zone's
-    name."""
+    """Everything about a round that can be checked without solving it — what a job refuses
+    at submission as the synchronous endpoint does: unique stop ids, the payload, the time
+    zone and start time, the client's matrix, the start state. Raises
+    :class:`core.exceptions.CoreError` naming the field; returns the departure (from the van's
+    position when it is under way) and the zone's name."""
     check_places(problem)
     check_payload(problem)
     start, timezone_name = round_start(problem)
     if problem.matrix is not None:
         build_legs(problem.places, problem.matrix)
-    return start, timezone_name
+    return check_start(problem, start.tzinfo) or start, timezone_name
 
 
 def round_start(problem: PlanProblem) -> tuple[dt.datetime, str]:

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from core.exceptions import InvalidParameterError
 from core.params import MIN_SOC_WINDOW
-from core.planning.model import PlanProblem
+from core.planning.model import PlanProblem, RoundFields
 from core.routing.tsp import Tour, solve_path
 
 #: The id of the van's position in the tour and the legs.
@@ -52,12 +52,14 @@ def check_start(
             "take",
             f"{field}.payload_kg",
         )
-    if fleet and state.payload_kg is not None and state.payload_kg > problem.van.payload_kg:
+    if state.payload_kg is not None and state.payload_kg > problem.van.payload_kg:
         raise InvalidParameterError(
             f"payload_kg {state.payload_kg:g} is more than the van's payload_kg "
-            f"{problem.van.payload_kg:g}",
+            f"{problem.van.payload_kg:g}: nothing is loaded on the way",
             f"{field}.payload_kg",
         )
+    if not fleet:
+        check_start_id(problem)
     moment = state.time.astimezone(zone)
     if moment.date() != problem.date:
         raise InvalidParameterError(
@@ -66,6 +68,20 @@ def check_start(
             f"{field}.time",
         )
     return moment
+
+
+def check_start_id(problem: RoundFields, field: str = "start_state") -> None:
+    """No place of a round under way is called :data:`START_ID`, the name of the van's
+    position in its tour and legs (``["start", "start", …]`` would not say which is which)."""
+    places = [("depot", problem.depot), *((f"stops[{k}]", s) for k, s in enumerate(problem.stops))]
+    places += [(f"chargers[{k}]", c) for k, c in enumerate(problem.chargers)]
+    for name, place in places:
+        if place.id == START_ID:
+            raise InvalidParameterError(
+                f"the id '{START_ID}' names the van's position when it plans from {field}; "
+                "call this place otherwise",
+                f"{name}.id",
+            )
 
 
 def under_way(problem: PlanProblem) -> PlanProblem:

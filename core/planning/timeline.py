@@ -12,11 +12,12 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from core.arrays import FloatArray
 from core.params import (
@@ -284,6 +285,25 @@ class Timeline:
     def duration_s(self) -> float:
         """From departure to return [s]."""
         return (self.speed.size - 1) * PLAN_DT_S
+
+    def driven(self, sample_at: Callable[[ArrayLike], Any]) -> Timeline:
+        """The marks moved to the samples of the trace the van drove (``sample_at``: a
+        sample of this timeline → the driven trace's, where a motor's cap slowed it)."""
+
+        def moved(marks: NDArray[np.int_]) -> NDArray[np.int_]:
+            return np.asarray(sample_at(marks), dtype=int)
+
+        def at_s(moment_s: float) -> float:
+            return float(sample_at(np.array([moment_s / PLAN_DT_S]))[0]) * PLAN_DT_S
+
+        return replace(
+            self,
+            depart=moved(self.depart),
+            arrive=moved(self.arrive),
+            serve=moved(self.serve),
+            leave=moved(self.leave),
+            breaks=[replace(b, start_s=at_s(b.start_s), end_s=at_s(b.end_s)) for b in self.breaks],
+        )
 
 
 @dataclass

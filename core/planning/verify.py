@@ -104,6 +104,14 @@ def simulate_route(
             timeline = laid_out(start, windows_s)
     check_representable(start, timeline.duration_s, "date")
     weather, warnings = scene.weather_for(start, timeline.duration_s)
+    back = at(start, timeline.duration_s)
+    if back.date() > start.date():
+        days = (back.date() - start.date()).days
+        warnings = [
+            *warnings,
+            f"the round ends on {back:%Y-%m-%d} at {back:%H:%M}, {days} day{'s' * (days > 1)} "
+            "after it starts: its drives, services, waits, charges and breaks take that long",
+        ]
     if timeline.capped_s > 0:
         cap_kw = (problem.van.vehicle.max_motor_power_w or 0.0) / 1000
         warnings = [
@@ -126,6 +134,7 @@ def simulate_route(
         charging=timeline.charging,
         box_start_c=box_start_c(problem),
     )
+    timeline = timeline.driven(result.sample_at)
     return _Split(problem, scene, order, result, timeline, start).result(solved, warnings)
 
 

@@ -1,10 +1,13 @@
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from core.arrays import reflected_cumsum
 from core.params import BatteryParams
 from core.physics.battery import (
     JOULES_PER_KWH,
+    SOC_TOLERANCE,
     battery_energy_j,
     capacity_factor,
     discharge,
@@ -80,3 +83,44 @@ def test_recharge_at_the_plug():
     battery = BatteryParams(usable_capacity_kwh=10, charging_efficiency=0.9)
     _, result = discharge(battery, np.array([2.0, 1.0]) * KWH)
     assert result.recharge_kwh == pytest.approx(3.0 / 0.9)
+
+
+def test_an_empty_battery_is_never_feasible_even_without_a_reserve():
+    # The trust issue's case: 23.3 kWh from a 10 kWh battery with min_soc 0. By hand: the
+    # state of charge goes 1 → 1 − 23.3/10 = −1.33, the margin is −13.3 kWh.
+    battery = BatteryParams(usable_capacity_kwh=10, initial_soc=1.0, min_soc=0.0)
+    soc, result = discharge(battery, np.array([5.0, 10.0, 8.3]) * KWH)
+    assert soc == pytest.approx([1.0, 0.5, -0.5, -1.33])
+    assert not result.feasible
+    assert result.min_soc == pytest.approx(-1.33) and result.final_soc == pytest.approx(-1.33)
+    assert result.margin_kwh == pytest.approx(-13.3)
+    assert result.first_infeasible_index == 2
+
+
+def test_exactly_empty_holds_a_reserve_of_zero():
+    battery = BatteryParams(usable_capacity_kwh=10, initial_soc=1.0, min_soc=0.0)
+    _, result = discharge(battery, np.array([4.0, 6.0]) * KWH)
+    assert result.feasible and result.min_soc == pytest.approx(0.0, abs=1e-12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    energies=st.lists(st.floats(-5, 12), min_size=1, max_size=40),
+    capacity=st.floats(1, 200),
+    initial=st.floats(0.2, 1.0),
+    reserve=st.floats(0.0, 0.19),
+    share=st.floats(0.5, 1.0),
+)
+def test_the_verdict_agrees_with_its_series(energies, capacity, initial, reserve, share):
+    """One series, three figures: feasible ⇔ min_soc ≥ reserve ⇔ margin ≥ 0, the lowest and
+    last values are the series', and the margin is the lowest value's distance to the
+    reserve in kWh."""
+    battery = BatteryParams(usable_capacity_kwh=capacity, initial_soc=initial, min_soc=reserve)
+    soc, result = discharge(battery, np.array(energies) * KWH, share)
+    assert result.min_soc == soc.min() and result.final_soc == soc[-1]
+    assert result.margin_kwh == pytest.approx((soc.min() - reserve) * capacity * share, abs=1e-9)
+    assert result.feasible == bool(soc.min() >= reserve - SOC_TOLERANCE)
+    assert result.feasible == (result.margin_kwh >= -SOC_TOLERANCE * capacity * share)
+    if result.first_infeasible_index is not None:
+        assert soc[result.first_infeasible_index] < reserve
+        assert (soc[: result.first_infeasible_index] >= reserve - SOC_TOLERANCE).all()

@@ -6,13 +6,17 @@ from hypothesis import strategies as st
 from core.exceptions import InvalidParameterError
 from core.params import STREET_TYPES, StreetType
 from core.physics.cycles import (
+    RAMP_TOLERANCE,
     drive_profile,
+    fastest_s,
     generate_leg,
     load_cycle_csv,
     nedc,
+    rest_to_rest,
     stretch_to_duration,
     trace_distance_m,
 )
+from core.physics.simulate import MAX_SPEED_MPS
 
 URBAN = STREET_TYPES["urban"]
 
@@ -195,3 +199,25 @@ def test_a_hop_shorter_than_one_sample_still_moves():
     assert trace[0] == trace[-1] == 0 and trace.size >= 3
     assert trace_distance_m(trace, 1.0) == pytest.approx(0.4)
     assert travelled[-1] == pytest.approx(0.4)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    distance=st.floats(0.1, 200_000),
+    duration=st.floats(0, 20_000),
+    accel=st.floats(0.2, 10),
+)
+def test_rest_to_rest_keeps_the_distance_within_the_vans_limits(distance, duration, accel):
+    """A leg a client's matrix gives too little time (10 m in 1 s, 100 km in 1000 s) is driven
+    over its whole distance, from rest to rest, never faster than 250 km/h and no steeper
+    than the van's acceleration (the audits found 10 m driven as 20.5 m, and a 100 km leg
+    scaled to 250.000…1 km/h, refused as a speed the client never sent)."""
+    top = MAX_SPEED_MPS
+    trace = rest_to_rest(distance, duration, accel, top)
+    assert trace[0] == 0 and trace[-1] == 0 and trace.size >= 3
+    assert trace_distance_m(trace, 1.0) == pytest.approx(distance, rel=1e-9)
+    assert trace.max() <= top
+    assert np.abs(np.diff(trace)).max() <= accel * (1 + RAMP_TOLERANCE)
+    # no longer than the time asked for, or the least the van needs, by more than a step or two
+    least = fastest_s(distance, accel, top)
+    assert trace.size - 1 <= max(duration, least) * (1 + RAMP_TOLERANCE) + 2

@@ -161,6 +161,15 @@ def test_each_reason_a_stop_is_left_out(stop_changes, vehicles, reason, words):
     left = result.unassigned[0]
     assert (left.id, left.reason) == ("odd", reason)
     assert words in left.detail
+    # a stop left out for payload is said in the answer's warnings too, with the figures
+    payload_warnings = [w for w in result.warnings if "left out for payload" in w]
+    if reason == "capacity":
+        assert payload_warnings == [
+            "1 stop left out for payload: the vans carry 550 kg in all (payload_kg × "
+            "max_trips) and the stops take 900 kg; check each van's payload_kg"
+        ]
+    else:
+        assert payload_warnings == []
 
 
 class _IslandRouter:
@@ -316,3 +325,48 @@ def test_duplicate_van_ids_are_named():
 
 def test_a_van_parameter_default_is_the_paper_van():
     assert FleetVehicle(id="a").van == VanParams()
+
+
+def test_a_stop_the_search_left_out_goes_to_an_idle_van_that_serves_it_alone(monkeypatch):
+    """The trust issue: stops were left out as "time_window" that one of 19 idle vans could
+    serve on a round of its own. Whatever the search leaves out (here: it ran out of time
+    before placing W3), an idle van that serves the stop alone, by the simulation, takes it."""
+    from core.planning import fleet as fleet_module
+    from core.routing.vrp import RoutingOutcome
+
+    stops, matrix = two_clusters(time_windows=[window("09:00", "09:20")])
+    problem = fleet(stops, [van("a"), van("b"), van("c"), van("d")], matrix=matrix)
+    ids = [s.id for s in problem.stops]
+    east = [ids.index(i) + 1 for i in ("E1", "E2", "E3")]
+    west = [ids.index(i) + 1 for i in ("W1", "W2")]  # W3 left out
+
+    def ran_out(_input, _budget_s, _initial=None):
+        return RoutingOutcome([east, west, [], []])
+
+    monkeypatch.setattr(fleet_module, "solve_routes", ran_out)
+    result = plan_fleet(problem)
+    assert_holds(result, problem)
+    assert result.unassigned == []
+    alone = [r for r in result.routes if [s.id for s in r.plan.stops] == ["W3"]]
+    assert len(alone) == 1 and alone[0].vehicle_id == "c"
+
+
+def test_a_stop_an_idle_van_cannot_serve_alone_says_what_its_simulation_broke(monkeypatch):
+    from core.planning import fleet as fleet_module
+    from core.routing.vrp import RoutingOutcome
+
+    stops, matrix = two_clusters(time_windows=[window("09:00", "09:20")])
+    small = BatteryParams(usable_capacity_kwh=1.0, min_soc=0.1)
+    problem = fleet(stops, [van("a"), van("b"), van("c", battery=small)], matrix=matrix)
+    ids = [s.id for s in problem.stops]
+    east = [ids.index(i) + 1 for i in ("E1", "E2", "E3")]
+    west = [ids.index(i) + 1 for i in ("W1", "W2")]
+
+    monkeypatch.setattr(
+        fleet_module, "solve_routes", lambda *_args: RoutingOutcome([east, west, []])
+    )
+    result = plan_fleet(problem)
+    assert_holds(result, problem)
+    (left,) = result.unassigned
+    assert left.id == "W3" and left.reason == "battery", left
+    assert "without a route" in left.detail or "simulation" in left.detail
