@@ -12,7 +12,7 @@ import datetime as dt
 from dataclasses import dataclass
 from typing import Any
 
-from sqlalchemy import JSON, String, delete, select
+from sqlalchemy import JSON, String, delete, select, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Mapped, mapped_column
 
@@ -111,21 +111,31 @@ class ProfileStore:
             raise ProfileExistsError(name) from None
         return Profile.of(row)
 
-    def put(self, name: str, description: str, van: VanParams, calibration: Any) -> bool:
-        """Create or replace the profile ``name``; whether it is new."""
-        with self.database.transaction() as session:
-            row = session.get(ProfileRow, name)
-            if row is not None:
-                row.description = description
-                row.van = van_to_json(van)
-                row.calibration = calibration
-                row.updated_at = now()
-                return False
-        try:
-            self.create(name, description, van, calibration)
-        except ProfileExistsError:  # made by another request meanwhile: this one replaces it
-            return self.put(name, description, van, calibration)
-        return True
+    def put(
+        self, name: str, description: str, van: VanParams, calibration: Any
+    ) -> tuple[Profile, bool]:
+        """Create or replace the profile ``name``: the profile as written, and whether it is
+        new. Each step is one statement, so a DELETE or a PUT of the same name at the same
+        moment makes this one try again, never fail half-way."""
+        values = {
+            "description": description,
+            "van": van_to_json(van),
+            "calibration": calibration,
+            "updated_at": now(),
+        }
+        for _ in range(PUT_ATTEMPTS):
+            with self.database.transaction() as session:
+                replaced = session.execute(
+                    update(ProfileRow).where(ProfileRow.name == name).values(**values)
+                )
+                if replaced.rowcount == 1:  # type: ignore[attr-defined]
+                    # the row is this transaction's until it commits: no DELETE takes it now
+                    return Profile.of(session.get(ProfileRow, name)), False  # type: ignore[arg-type]
+            try:
+                return self.create(name, description, van, calibration), True
+            except ProfileExistsError:  # made by another request meanwhile: replace it
+                continue
+        raise ProfileBusyError(name)
 
     def get(self, name: str) -> Profile | None:
         with self.database.transaction() as session:
@@ -166,6 +176,18 @@ class ProfileStore:
             if row is None:
                 return None
             return StoredCalibration(row.id, van_from_json(row.van), row.answer, row.created_at)
+
+
+#: How often a PUT tries again when other requests keep creating and deleting the same name.
+PUT_ATTEMPTS = 5
+
+
+class ProfileBusyError(Exception):
+    """Other requests create and delete the profile faster than a PUT can write it."""
+
+    def __init__(self, name: str) -> None:
+        super().__init__(name)
+        self.name = name
 
 
 class ProfileExistsError(Exception):

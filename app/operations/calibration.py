@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 import uuid
 from typing import Any
 
@@ -26,16 +27,16 @@ from core.calibration.fit import (
     MeasuredTrip,
     TripFit,
     calibrate,
-    check_trip,
+    check_trips,
 )
 from core.exceptions import InvalidParameterError, TooMuchToWaitForError
-from core.params import CargoBoxParams
+from core.params import CargoBoxParams, VanParams
 
 
 def measured_trips(request: CalibrationRequest) -> list[MeasuredTrip]:
     """The request's trips for the core, each checked (a 422 names trip, column and row)."""
     trips = []
-    for k, trip in enumerate(request.trips):
+    for trip in request.trips:
 
         def column(values: list[float] | None) -> np.ndarray | None:
             return None if values is None else np.asarray(values, dtype=float)
@@ -53,8 +54,8 @@ def measured_trips(request: CalibrationRequest) -> list[MeasuredTrip]:
             ambient_c=column(trip.ambient_c),
             door_openings=trip.door_openings,
         )
-        check_trip(measured, f"trips[{k}]")
         trips.append(measured)
+    check_trips(trips)
     return trips
 
 
@@ -85,9 +86,18 @@ def run_calibration(request: CalibrationRequest, settings: Settings) -> Calibrat
     van = van_of(request, settings)
     response = answer(calibrate(van, measured_trips(request), request.fit_parameters()))
     profile_store(settings.database_url).save_calibration(
-        response.id, van, response.model_dump(mode="json")
+        response.id, profile_base(request, van, settings), response.model_dump(mode="json")
     )
     return response
+
+
+def profile_base(request: CalibrationRequest, van: VanParams, settings: Settings) -> VanParams:
+    """The van a profile made from this calibration starts from: the van the fit started
+    from, but for the load of the measured trips (``payload_kg``), which is a fact of those
+    trips, not of the van — the profile keeps its preset's (or profile's) payload, and
+    differs from it only in what the request changed of the van and what the fit fitted."""
+    base = van_of(request.model_copy(update={"payload_kg": None}), settings)
+    return van.model_copy(update={"payload_kg": base.payload_kg})
 
 
 def _finite(value: float) -> float | None:
@@ -169,12 +179,25 @@ def csv_columns(text: str, field: str) -> dict[str, list[float]]:
     return columns
 
 
+#: A number as a spreadsheet writes one: ASCII digits, one point, an exponent. Python's
+#: float() also reads ``1_0`` and other scripts' digits (``١٠``) as 10: not a telematics cell.
+_CSV_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+
+
+def _infinite(text: str) -> float:
+    """``inf`` or ``nan`` as float() reads them (refused as not finite), else ValueError."""
+    value = float(text)
+    if math.isfinite(value):
+        raise ValueError(text)
+    return value
+
+
 def _number(cell: str, delimiter: str, field: str) -> float:
     text = cell.strip()
     if delimiter == ";":
         text = text.replace(",", ".")
     try:
-        value = float(text)
+        value = float(text) if _CSV_NUMBER.fullmatch(text) else _infinite(text)
     except ValueError:
         raise InvalidParameterError(f"{cell[:40]!r} is not a number", field) from None
     if not math.isfinite(value):

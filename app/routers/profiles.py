@@ -10,7 +10,13 @@ from starlette.exceptions import HTTPException
 
 from app.deps import SettingsDep
 from app.operations.profiles import profile_out, profile_van
-from app.profiles import Profile, ProfileExistsError, ProfileStore, profile_store
+from app.profiles import (
+    Profile,
+    ProfileBusyError,
+    ProfileExistsError,
+    ProfileStore,
+    profile_store,
+)
 from app.schemas.base import ProfileName
 from app.schemas.profiles import (
     VehicleProfileOut,
@@ -110,11 +116,16 @@ def put_profile(
     if request.name is not None and request.name != name:
         raise InvalidParameterError(f"the body names {request.name!r}, the path {name!r}", "name")
     van, calibration = profile_van(request, settings)
-    store = _store(settings)
-    if store.put(name, request.description, van, calibration):
+    try:
+        written, created = _store(settings).put(name, request.description, van, calibration)
+    except ProfileBusyError:
+        raise HTTPException(
+            409, f"other requests keep creating and deleting {name!r}; try again"
+        ) from None
+    if created:
         response.status_code = 201
         response.headers["Location"] = f"/v1/vehicle-profiles/{name}"
-    return profile_out(_found(store.get(name), name))
+    return profile_out(written)
 
 
 @router.delete(

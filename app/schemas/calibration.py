@@ -68,6 +68,12 @@ class TripRequest(ApiModel):
 class CalibrationRequest(VanRequest):
     """The starting van (a preset with overrides, as in plans), what to fit, the trips."""
 
+    payload_kg: Annotated[Annotated[float, Field(ge=0, le=40_000)] | None, NotNull] = absent(
+        "The load the measured trips carried [kg] where a trip has no payload_kg column; "
+        "preset value if absent. A fact of the trips, not of the van: a profile made from "
+        "this calibration keeps its preset's payload."
+    )
+
     parameters: list[FittableName | FitParameter] = Field(
         default_factory=list,
         max_length=len(FITTABLE),

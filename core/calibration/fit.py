@@ -40,7 +40,13 @@ from core.params import (
     Weather,
 )
 from core.params.base import Params
-from core.physics.simulate import MAX_SPEED_MPS, SimulationResult, simulate
+from core.physics.simulate import (
+    MAX_ABS_GRADE,
+    MAX_PAYLOAD_KG,
+    MAX_SPEED_MPS,
+    SimulationResult,
+    simulate,
+)
 
 #: Each parameter that can be fitted and the section of the van that holds it.
 FITTABLE: dict[str, type[Params]] = {  # the names of FittableName
@@ -79,6 +85,10 @@ MIN_TRIP_S = 60.0
 DIFF_STEP = 1e-4
 #: Folds of the cross-validation when no trip is marked for validation (at most one per trip).
 FOLDS = 5
+#: Largest power a measured channel may hold [W]: no van draws or regenerates 5 MW.
+MAX_MEASURED_POWER_W = 5e6
+#: Sparsest sampling a trip may have (its median step) [s]: the simulation's longest step.
+MAX_STEP_S = 3600.0
 
 
 FittableName = Literal[
@@ -198,8 +208,7 @@ def calibrate(
     chosen = _checked(van, parameters or _defaults(trips))
     if not trips:
         raise InvalidParameterError("at least one trip is needed", "trips")
-    for k, trip in enumerate(trips):
-        check_trip(trip, f"trips[{k}]")
+    check_trips(trips)
     resampled = [_resample(trip) for trip in trips]
     fitted = [r for r in resampled if r.trip.role != "validation"]
     held_out = [r for r in resampled if r.trip.role == "validation"]
@@ -218,11 +227,37 @@ def calibrate(
     return Calibration(result.parameters, best, trips_fit, validation, method, warnings)
 
 
+#: What each column may hold: the simulation's own bounds (a grade, a payload, the weather's
+#: temperatures) and, for a measured power, what no van draws or regenerates [W].
+COLUMN_BOUNDS: dict[str, tuple[float, float]] = {
+    "speed_mps": (0.0, MAX_SPEED_MPS),
+    "grade": (-MAX_ABS_GRADE, MAX_ABS_GRADE),
+    "payload_kg": (0.0, MAX_PAYLOAD_KG),
+    "ambient_c": (-60.0, 60.0),
+    **{channel: (-MAX_MEASURED_POWER_W, MAX_MEASURED_POWER_W) for channel in CHANNELS},
+}
+
+
+def check_trips(trips: Sequence[MeasuredTrip]) -> None:
+    """Every trip usable (:func:`check_trip`) and named once."""
+    seen: dict[str, int] = {}
+    for k, trip in enumerate(trips):
+        if trip.id in seen:
+            raise InvalidParameterError(
+                f"trip id {trip.id[:60]!r} is used twice (also by trips[{seen[trip.id]}]); ids "
+                "must be unique",
+                f"trips[{k}].id",
+            )
+        seen[trip.id] = k
+        check_trip(trip, f"trips[{k}]")
+
+
 def check_trip(trip: MeasuredTrip, where: str) -> None:
     """Refuse a trip the fit cannot use, naming the column and the row (``trips[2].speed_mps[17]``):
-    columns of different lengths, a value that is not a finite number, a negative speed, times
-    that do not increase, a trip shorter than :data:`MIN_TRIP_S`, nothing measured or a channel
-    not in :data:`CHANNELS`."""
+    columns of different lengths, a value that is not a finite number or outside what the
+    column may hold (:data:`COLUMN_BOUNDS`), times that do not increase, a trip shorter than
+    :data:`MIN_TRIP_S` or sampled more sparsely than once an hour, a door opening after its
+    end, nothing measured or a channel not in :data:`CHANNELS`."""
     time_s = np.asarray(trip.time_s, dtype=float)
     columns: dict[str, FloatArray | None] = {
         "time_s": time_s,
@@ -259,12 +294,12 @@ def check_trip(trip: MeasuredTrip, where: str) -> None:
         bad = np.flatnonzero(~np.isfinite(array))
         if bad.size:
             raise InvalidParameterError("must be a finite number", f"{field}[{bad[0]}]")
-    speed = np.asarray(trip.speed_mps, dtype=float)
-    wrong = np.flatnonzero((speed < 0) | (speed > MAX_SPEED_MPS))
-    if wrong.size:
-        raise InvalidParameterError(
-            f"a speed must be within 0…{MAX_SPEED_MPS:.1f} m/s", f"{where}.speed_mps[{wrong[0]}]"
-        )
+        low, high = COLUMN_BOUNDS.get(name, (-math.inf, math.inf))
+        wrong = np.flatnonzero((array < low) | (array > high))
+        if wrong.size:
+            raise InvalidParameterError(
+                f"{array[wrong[0]]:g} is not within {low:g}…{high:g}", f"{field}[{wrong[0]}]"
+            )
     steps = np.diff(time_s)
     backwards = np.flatnonzero(steps <= 0)
     if backwards.size:
@@ -279,6 +314,20 @@ def check_trip(trip: MeasuredTrip, where: str) -> None:
             f"a trip must last at least {MIN_TRIP_S:.0f} s; this one lasts {span:g} s",
             f"{where}.time_s",
         )
+    if float(np.median(steps)) > MAX_STEP_S:
+        raise InvalidParameterError(
+            f"the samples are {float(np.median(steps)):g} s apart (the median step); the fit "
+            f"needs one at least every {MAX_STEP_S:.0f} s",
+            f"{where}.time_s",
+        )
+    span_s = float(time_s[-1] - time_s[0])
+    for k, opening in enumerate(trip.door_openings):
+        if opening.start_s > span_s:
+            raise InvalidParameterError(
+                f"starts {opening.start_s:g} s after the first sample, after the trip ends "
+                f"({span_s:g} s)",
+                f"{where}.door_openings[{k}].start_s",
+            )
 
 
 def _defaults(trips: Sequence[MeasuredTrip]) -> list[FitParameter]:
@@ -542,14 +591,10 @@ def _trip_fit(van: VanParams, trip: _Resampled, role: str) -> TripFit:
     spread = float(np.sum((measured - measured.mean()) ** 2))
     r2 = 1.0 - float(np.sum(error**2)) / spread if spread > 0 else math.nan
     measured_j = float(np.sum(measured)) * trip.dt_s
-    energy_error = (float(np.sum(simulated)) * trip.dt_s - measured_j) / abs(measured_j) * 100
-    return TripFit(
-        trip.trip.id,
-        role,
-        r2,
-        float(np.sqrt(np.mean(error**2))),
-        energy_error if measured_j else math.nan,
-    )
+    simulated_j = float(np.sum(simulated)) * trip.dt_s
+    # No energy measured (a channel of zeros): no relative error to give.
+    energy_error = (simulated_j - measured_j) / abs(measured_j) * 100 if measured_j else math.nan
+    return TripFit(trip.trip.id, role, r2, float(np.sqrt(np.mean(error**2))), energy_error)
 
 
 def _cross_validation(

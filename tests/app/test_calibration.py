@@ -68,12 +68,35 @@ def bad(change) -> dict:
         (lambda t: t.update(time_s=t["time_s"][:50], speed_mps=t["speed_mps"][:50],
                             battery_power_w=t["battery_power_w"][:50]), "trips[1].time_s"),
         (lambda t: t.pop("battery_power_w"), "trips[1]"),
+        # the trust issue's audit: a 500, or a 422 naming a field without its trip
+        (lambda t: t["battery_power_w"].__setitem__(5, 1e308), "trips[1].battery_power_w[5]"),
+        (lambda t: t.update(payload_kg=[50_000.0] * len(t["time_s"])), "trips[1].payload_kg[0]"),
+        (lambda t: t.update(grade=[0.0] * 3 + [0.9] * (len(t["time_s"]) - 3)),
+         "trips[1].grade[3]"),
+        (lambda t: t.update(ambient_c=[25.0] * 4 + [70.0] * (len(t["time_s"]) - 4)),
+         "trips[1].ambient_c[4]"),
+        (lambda t: t.update(door_openings=[{"start_s": 1e6, "duration_s": 30}]),
+         "trips[1].door_openings[0].start_s"),
+        (lambda t: t.update(time_s=[k * 4000.0 for k in range(len(t["time_s"]))]),
+         "trips[1].time_s"),
+        (lambda t: t.update(id="city"), "trips[1].id"),
     ],
 )  # fmt: skip
 def test_a_bad_trip_is_a_422_naming_trip_column_and_row(client, change, field):
     response = client.post("/v1/calibrations", json=bad(change))
     assert response.status_code == 422, response.text
     assert any(e["field"] == field for e in response.json()["errors"]), response.json()
+
+
+def test_a_trip_whose_measured_power_is_all_zero_is_fitted_without_a_relative_error(client):
+    # The audit's 500: a division by the measured energy, 0.
+    body = copy.deepcopy(CALIBRATION_EXAMPLE)
+    body["trips"][1]["battery_power_w"] = [0.0] * len(body["trips"][1]["time_s"])
+    response = client.post("/v1/calibrations", json=body)
+    assert response.status_code == 200, response.text
+    fits = {t["id"]: t for t in response.json()["trips"]}
+    assert fits["ring-road"]["energy_error_pct"] is None
+    assert fits["city"]["energy_error_pct"] is not None
 
 
 def test_a_nan_in_a_column_is_named(client):
@@ -181,6 +204,10 @@ def _cell(row: int, column: int, value: str):
         (_cell(5, 2, "1,2"), "trips[1].time_s[5]", "cells"),
         (lambda t: t.replace("speed_mps", "velocity", 1), "trips[1]", "unknown column"),
         (lambda t: "\r\n".join(t.split("\r\n")[:30]), "trips[1].time_s", ""),
+        # float() reads these as 10; a spreadsheet never writes them
+        (_cell(40, 1, "1_0"), "trips[1].speed_mps[40]", "not a number"),
+        (_cell(40, 1, "\u0661\u0660"), "trips[1].speed_mps[40]", "not a number"),
+        (_cell(40, 1, "nan"), "trips[1].speed_mps[40]", "finite"),
     ],
 )
 def test_a_bad_csv_is_a_422_naming_trip_column_and_row(client, edit, field, words):

@@ -263,3 +263,26 @@ def test_profiles_are_shared_by_replicas_on_postgresql_and_outlive_them():
         # Both servers are gone: the profile is in PostgreSQL, for the next one to start.
         kept = ProfileStore(Database(env["COLDROUTE_DATABASE_URL"])).get("van-17")
         assert kept is not None and kept.van.battery.usable_capacity_kwh == 75
+
+
+def test_a_profile_from_a_calibration_differs_from_its_van_only_in_what_was_fitted(client):
+    """The trust issue: the 300 kg the measured trips carried became the profile's payload
+    (the preset carries more), and a fleet on that profile left stops out as "the fleet is
+    full". A profile keeps exactly what the fit fitted, and nothing else of the trips."""
+    body = copy.deepcopy(CALIBRATION_EXAMPLE) | {"payload_kg": 300.0}
+    body["vehicle"] = body["vehicle"] | {"mass_kg": 3050.0}  # a fact of the van: kept
+    fitted = client.post("/v1/calibrations", json=body).json()
+    made = client.post(
+        "/v1/vehicle-profiles", json={"name": unique("fitted"), "calibration_id": fitted["id"]}
+    ).json()
+    preset = PRESETS[CALIBRATION_EXAMPLE["vehicle"]["preset"]].van()
+    start = preset.model_copy(
+        update={"vehicle": preset.vehicle.model_copy(update={"mass_kg": 3050.0})}
+    ).model_dump(mode="json")
+    assert made["payload_kg"] == preset.payload_kg != 300.0
+    for section in ("vehicle", "cargo_box", "battery"):
+        changed = {k for k, v in made[section].items() if v != start[section][k]}
+        expected = set(fitted.get(section, {})) if section != "battery" else set()
+        assert changed == {k for k in expected if fitted[section][k] != start[section][k]}
+    for name, value in fitted["vehicle"].items():
+        assert made["vehicle"][name] == value
