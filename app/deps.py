@@ -5,7 +5,7 @@ from __future__ import annotations
 import secrets
 from typing import Annotated
 
-from fastapi import Depends, HTTPException, Request
+from fastapi import Depends, Request
 
 from app.execution import Executor
 from app.jobs.store import JobStore, store_for
@@ -30,17 +30,16 @@ def _job_store(settings: SettingsDep) -> JobStore:
 StoreDep = Annotated[JobStore, Depends(_job_store)]
 
 
-def require_api_key(settings: SettingsDep, request: Request) -> None:
-    """401 unless the request carries the configured key (no key configured: open). The key
-    is a security scheme in the OpenAPI document (app.openapi_doc), not a parameter."""
+def api_key_refusal(settings: Settings, sent: list[str]) -> str | None:
+    """Why the ``X-API-Key`` values ``sent`` do not open the API, or None when they do (no key
+    configured: open). The key is a security scheme in the OpenAPI document
+    (app.openapi_doc), checked by :class:`app.main.ApiKey` before a body is read."""
     if settings.api_key is None:
-        return
-    sent = request.headers.getlist("x-api-key")
+        return None
     expected = settings.api_key.get_secret_value().encode()
     # Bytes: compare_digest refuses non-ASCII text, and any key a client sends is just wrong. A
     # repeated header is refused whatever its values: one server may read the first, a proxy
     # the last.
-    if len(sent) != 1 or not secrets.compare_digest(sent[0].encode(), expected):
-        raise HTTPException(
-            401, "missing, repeated or wrong X-API-Key", headers={"WWW-Authenticate": "ApiKey"}
-        )
+    if len(sent) != 1 or not secrets.compare_digest(sent[0].encode("latin-1"), expected):
+        return "missing, repeated or wrong X-API-Key"
+    return None

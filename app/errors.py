@@ -94,18 +94,46 @@ def _echo(text: str, limit: int) -> str:
     return text if len(text) <= limit else f"{text[:limit]}… ({len(text):,} characters)"
 
 
-def _location(loc: tuple[Any, ...], kind: str = "") -> str:
+def _location(loc: tuple[Any, ...], kind: str = "", body: Any = None) -> str:
     """``("body", "stops", 3, "lat")`` → ``stops[3].lat``; a body that is not JSON → ``body``
-    (its location is the character where JSON broke, not a field)."""
+    (its location is the character where JSON broke, not a field).
+
+    Every name is one the client sent, read against the ``body`` it sent: pydantic puts the
+    branch of a union it tried in the location (``FitParameter``, ``literal['a','b']``), and
+    such a name, which is not in the body, is left out — but the last name of an error of a
+    field left out (``missing``), which names the field to send."""
     if kind == "json_invalid":
         return "body"
-    path = ""
-    for part in loc[1:] if loc and loc[0] == "body" else loc:
-        if isinstance(part, str) and part.startswith(BRANCH_TAG):  # a union's branch
+    in_body = bool(loc) and loc[0] == "body"
+    parts = list(loc[1:] if in_body else loc)
+    path, value, known = "", body, in_body and body is not None
+    for index, part in enumerate(parts):
+        if isinstance(part, str) and part.startswith(BRANCH_TAG):  # a tagged union's branch
             continue
+        last = index == len(parts) - 1
+        if known and not isinstance(part, int):
+            if isinstance(value, dict) and part in value:
+                value = value[part]
+            elif not last or _union_branch(part):
+                continue  # a union's branch, not a field of the body
+            else:  # a field left out (missing, or one of two to send): a field all the same
+                known = False
+        elif known:
+            value = value[part] if isinstance(value, list) and 0 <= part < len(value) else None
+            known = value is not None
         name = _echo(str(part), MAX_ECHO_PART)
         path += f"[{part}]" if isinstance(part, int) else (f".{name}" if path else name)
     return path or "body"
+
+
+#: How pydantic names the branches of a union in a location: a model's class name, a
+#: ``literal[…]``, ``function-after[…]``, ``list[…]``, or a plain type's name.
+_PLAIN_TYPES = frozenset({"str", "int", "float", "bool", "none", "bytes", "decimal"})
+
+
+def _union_branch(part: str) -> bool:
+    """Whether a name in a location that the body does not have is a union's branch."""
+    return "[" in part or part[:1].isupper() or part in _PLAIN_TYPES
 
 
 def _message(error: Any) -> str:
@@ -133,7 +161,7 @@ def _validation(_: Request, error: RequestValidationError) -> JSONResponse:
     found = error.errors()
     errors = [
         {
-            "field": _location(tuple(e["loc"]), e["type"]),
+            "field": _location(tuple(e["loc"]), e["type"], error.body),
             "message": _message(e),
             "type": e["type"],
         }
@@ -158,7 +186,9 @@ def _http(request: Request, error: StarletteHTTPException) -> JSONResponse:
         }
         return problem(405, "Method not allowed", str(error.detail), headers=headers)
     if error.status_code == 400:  # a body that cannot even be read is an invalid request
-        detail = f"the body cannot be read as JSON ({error.detail})"
+        kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+        what = kind if kind.startswith("multipart/") else "JSON"
+        detail = f"the body cannot be read as {_echo(what, MAX_ECHO_PART)} ({error.detail})"
         errors = [{"field": "body", "message": detail, "type": "json_invalid"}]
         return problem(422, "Invalid request", detail, errors=errors)
     titles = {

@@ -27,7 +27,8 @@ STATUS_TEXT = {
 #: What a status means for the vehicle profiles' operations, where the jobs' text is wrong.
 PROFILE_STATUS_TEXT = {
     404: "No vehicle profile of that name.",
-    409: "A vehicle profile of that name exists (PUT replaces it).",
+    409: "A vehicle profile of that name exists (POST; PUT replaces it), or other requests "
+    "kept creating and deleting it while a PUT wrote it (try again).",
 }
 #: The error statuses each operation can answer.
 ERRORS: dict[str, tuple[int, ...]] = {
@@ -42,7 +43,7 @@ ERRORS: dict[str, tuple[int, ...]] = {
     "createVehicleProfile": (401, 409, 413, 422, 503),
     "listVehicleProfiles": (401, 503),
     "getVehicleProfile": (401, 404, 422, 503),
-    "replaceVehicleProfile": (401, 413, 422, 503),
+    "replaceVehicleProfile": (401, 409, 413, 422, 503),
     "deleteVehicleProfile": (401, 404, 422, 503),
     "createJob": (401, 409, 413, 422, 503),
     "listJobs": (401, 422, 503),

@@ -57,7 +57,13 @@ class Settings(BaseSettings):
         30_000_000.0,
         gt=0,
         description="Most time a synchronous study may simulate [s] (about a year of driving, "
-        "a few seconds of work); beyond, a 413 points to jobs, which have no such bound.",
+        "a few seconds of work); beyond, a 413 points to jobs (max_job_simulated_s).",
+    )
+    max_job_simulated_s: float = Field(
+        300_000_000.0,
+        gt=0,
+        description="Most time a study submitted as a job may simulate [s] (about ten years "
+        "of driving).",
     )
     max_sync_calibration_samples: int = Field(
         100_000,

@@ -81,8 +81,10 @@ def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepRe
     )
 
 
-def check_scenarios(request: ScenariosRequest, settings: Settings) -> None:
-    """A scenario grid within the server's limit of cells × stops."""
+def check_scenarios(request: ScenariosRequest, settings: Settings, job: bool = False) -> None:
+    """A scenario grid within the server's limits: cells × stops, and the time the cells
+    simulate — at least their services' — within what a synchronous study (a 413 pointing to
+    jobs) or a job simulates."""
     seasons = request.seasons or default_seasons(request.plan.date.year)
     n_cells = (
         len(seasons)
@@ -94,6 +96,22 @@ def check_scenarios(request: ScenariosRequest, settings: Settings) -> None:
             f"{n_cells} cells of {len(request.plan.stops)} stops; this server evaluates at most "
             f"{settings.max_study_cell_stops} cell-stops per study",
             "plan.stops",
+        )
+    least_s = n_cells * sum(stop.service_time_s for stop in request.plan.stops)
+    limit_s = settings.max_job_simulated_s if job else settings.max_sync_simulated_s
+    if least_s > limit_s:
+        said = (
+            f"{n_cells} cells of a round whose services alone take "
+            f"{least_s / n_cells / 3600:,.1f} h simulate at least {least_s / 86_400:,.0f} days; "
+        )
+        if job:
+            raise LimitExceededError(
+                f"{said}a job simulates at most {limit_s / 86_400:,.0f}: fewer cells", "seasons"
+            )
+        raise TooMuchToWaitForError(
+            f"{said}a synchronous study simulates at most {limit_s / 86_400:,.0f}: fewer "
+            "cells, or submit it as a job (POST /v1/jobs, type scenarios)",
+            "seasons",
         )
 
 
@@ -126,7 +144,7 @@ def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosRes
 
 def check_scenarios_job(request: ScenariosRequest, settings: Settings) -> None:
     """Everything but the grid itself: what a job refuses at submission."""
-    check_scenarios(request, settings)
+    check_scenarios(request, settings, job=True)
     try:
         check_plan(request.plan, settings)
     except CoreError as error:

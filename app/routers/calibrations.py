@@ -102,7 +102,7 @@ async def create_calibration_from_csv(
         request = CalibrationRequest.model_validate(merged)
     except ValidationError as error:
         raise RequestValidationError(
-            [e | {"loc": ("body", *e["loc"])} for e in error.errors()]
+            [e | {"loc": ("body", *e["loc"])} for e in error.errors()], body=merged
         ) from None
     return await pool.run(
         operation.run_calibration, request, settings, disconnected=http.is_disconnected

@@ -32,7 +32,8 @@ def _validated(submission: JobSubmission, settings: Settings) -> BaseModel:
         request: BaseModel = kind.request.model_validate(submission.request)
     except ValidationError as error:
         raise RequestValidationError(
-            [e | {"loc": ("body", "request", *e["loc"])} for e in error.errors()]
+            [e | {"loc": ("body", "request", *e["loc"])} for e in error.errors()],
+            body={"request": submission.request},
         ) from None
     try:
         kind.check(request, settings)

@@ -53,5 +53,6 @@ def viewer(settings: SettingsDep) -> Response:
 @router.get("/viewer/static/{name}")
 def asset(name: str) -> Response:
     if name not in ASSETS:
-        raise HTTPException(404, f"no viewer asset {name!r}")
+        shown = name if len(name) <= 64 else f"{name[:64]}… ({len(name):,} characters)"
+        raise HTTPException(404, f"no viewer asset {shown!r}")
     return Response(_asset(name), media_type=ASSETS[name], headers={"Cache-Control": "no-cache"})

@@ -8,6 +8,7 @@ import datetime as dt
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, get_args
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -106,8 +107,21 @@ def _overrides(name: str, params: type[Params], doc: str, **extra: Any) -> type[
     return create_model(name, __base__=ApiModel, __doc__=doc, **fields)
 
 
-#: A vehicle profile's name: letters, digits, ``.``, ``_`` and ``-``, as in a URL path.
-ProfileName = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9._-]+$")]
+def _not_a_path_step(name: str) -> str:
+    if name in (".", ".."):
+        raise ValueError(
+            f"{name!r} is a step in a URL path, not a name: its URL would not reach it"
+        )
+    return name
+
+
+#: A vehicle profile's name: letters, digits, ``.``, ``_`` and ``-``, as in a URL path (not
+#: ``.`` or ``..``, which a URL path reads as steps).
+ProfileName = Annotated[
+    str,
+    Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9._-]+$"),
+    AfterValidator(_not_a_path_step),
+]
 
 
 if TYPE_CHECKING:  # the request models are built at run time from the core's parameters
@@ -302,14 +316,24 @@ class BatteryOut(ApiModel):
     """Whether the battery holds out with its reserve."""
 
     feasible: bool = Field(
-        ..., description="True when the state of charge never falls below the reserve (min_soc)."
+        ...,
+        description="True when the state of charge never falls below the reserve (min_soc): "
+        "min_soc ≥ reserve_soc, margin_kwh ≥ 0. An empty battery is never feasible.",
     )
-    min_soc: float = Field(..., description="Lowest state of charge [–].")
+    min_soc: float = Field(
+        ...,
+        description="Lowest state of charge [–]. Never clipped: below 0 it is the energy the "
+        "battery does not hold, as a share of usable_capacity_kwh (the van would stop there).",
+    )
     reserve_soc: float | None = Field(
         None, description="The reserve the battery was held to: battery.min_soc [–]."
     )
-    final_soc: float = Field(..., description="State of charge at the end [–].")
-    margin_kwh: float = Field(..., description="Energy above the reserve at the lowest point.")
+    final_soc: float = Field(..., description="State of charge at the end [–], as min_soc.")
+    margin_kwh: float = Field(
+        ...,
+        description="Energy above the reserve at the lowest point [kWh]: (min_soc − "
+        "reserve_soc) × usable_capacity_kwh; negative: the shortfall.",
+    )
     required_capacity_kwh: float = Field(..., description="Smallest usable capacity that works.")
     usable_capacity_kwh: float | None = Field(
         None, description="Usable capacity on the day, after temperature derating [kWh]."

@@ -891,8 +891,11 @@ function download(name, type, text) {
 }
 
 function csvCell(value) {
-  const text = String(value);
-  return /[",\n]/.test(text) ? `"${text.replace(/"/g, '""')}"` : text;
+  // A text a spreadsheet would run as a formula (=, +, -, @, a tab or a return first) is
+  // kept as text by a leading apostrophe (OWASP, "CSV Injection"); numbers stay numbers.
+  let text = String(value);
+  if (/^[=+\-@\t\r]/.test(text) && !/^[-+]?\d+(\.\d+)?$/.test(text)) text = `'${text}`;
+  return /[",\n\r]/.test(text) ? `"${text.replace(/"/g, '""')}"` : text;
 }
 
 function exportCsv() {

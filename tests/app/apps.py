@@ -9,6 +9,7 @@ from fastapi.testclient import TestClient
 
 from app.main import create_app
 from app.settings import Settings
+from tests.app.invariants import CheckedClient
 
 _CLIENTS: dict[str, TestClient] = {}
 
@@ -17,7 +18,7 @@ def app_client(**settings: Any) -> TestClient:
     """The session's client of an app with these settings (created on first use)."""
     key = repr(sorted(settings.items()))
     if key not in _CLIENTS:
-        client = TestClient(create_app(Settings(**settings)))
+        client = CheckedClient(create_app(Settings(**settings)))
         executor = client.app.state.executor  # type: ignore[attr-defined]
         executor.pool.warm(executor.load)
         _CLIENTS[key] = client

@@ -9,9 +9,9 @@ import logging
 
 import httpx
 import pytest
-from fastapi.testclient import TestClient
 
 from app.examples import (
+    FLEET_PLAN_EXAMPLE,
     PLAN_EXAMPLE,
     SCENARIOS_EXAMPLE,
     SIMULATE_EXAMPLE,
@@ -22,6 +22,7 @@ from app.main import app as default_app
 from app.main import create_app
 from app.settings import Settings
 from benchmarks.common import Server
+from tests.app.invariants import CheckedClient
 
 PROBLEM = "application/problem+json"
 
@@ -67,7 +68,7 @@ def test_the_end_of_the_calendar_is_a_422_naming_the_date(client, path, body, fi
 
 @pytest.mark.parametrize("key", ["café".encode(), b"\xff\xfe", "s3cret\u00a0".encode()])
 def test_a_non_ascii_api_key_is_a_401(key):
-    secured = TestClient(create_app(Settings(api_key="s3cret")), raise_server_exceptions=False)
+    secured = CheckedClient(create_app(Settings(api_key="s3cret")), raise_server_exceptions=False)
     response = secured.get("/v1/presets", headers={"X-API-Key": key})
     assert response.status_code == 401
     assert response.headers["content-type"] == PROBLEM
@@ -229,14 +230,41 @@ def test_a_huge_preset_name_is_refused_without_being_echoed(client):
     assert len(response.content) < 2_000 and "x" * 100 not in response.text
 
 
-def test_a_tiny_battery_reports_the_shortfall_not_a_negative_charge(client):
+def test_a_tiny_battery_reports_the_shortfall_in_its_charge_and_margin(client):
     body = PLAN_EXAMPLE | {"battery": {"usable_capacity_kwh": 0.1}}
-    battery = client.post("/v1/plans", json=body).json()["battery"]
+    answer = client.post("/v1/plans", json=body).json()
+    battery = answer["battery"]
     assert battery["feasible"] is False and battery["first_infeasible_leg"] == 0
-    assert battery["min_soc"] == 0 and battery["final_soc"] == 0
+    # Never clipped at empty: the charge goes as far below 0 as the energy it lacks.
+    needed_kwh = answer["totals"]["energy_kwh"]["total"]
+    assert battery["final_soc"] == pytest.approx(1 - needed_kwh / 0.1, rel=1e-6)
+    assert battery["min_soc"] <= battery["final_soc"] < -10
     # The shortfall: what the round needs beyond the usable 0.1 kWh and its reserve.
-    assert battery["margin_kwh"] < -1
+    assert battery["margin_kwh"] == pytest.approx(
+        (battery["min_soc"] - battery["reserve_soc"]) * 0.1
+    )
     assert battery["required_capacity_kwh"] > 1
+
+
+@pytest.mark.parametrize("endpoint", ["/v1/plans", "/v1/fleet-plans"])
+def test_an_empty_battery_without_a_reserve_is_not_feasible(client, endpoint):
+    """The trust issue's case: a round that needs more than twice its 10 kWh with min_soc 0
+    came back feasible, its charge clipped at 0 before the reserve was compared."""
+    battery = {"usable_capacity_kwh": 3, "initial_soc": 1.0, "min_soc": 0}
+    if endpoint == "/v1/plans":
+        body = PLAN_EXAMPLE | {"battery": battery}
+        answer = client.post(endpoint, json=body).json()
+    else:
+        body = FLEET_PLAN_EXAMPLE | {
+            "vehicles": [FLEET_PLAN_EXAMPLE["vehicles"][1] | {"battery": battery}],
+            "stops": PLAN_EXAMPLE["stops"],
+        }
+        answer = client.post(endpoint, json=body).json()
+        assert answer["routes"] == [] or not answer["routes"][0]["battery"]["feasible"]
+        return
+    verdict = answer["battery"]
+    assert not verdict["feasible"] and verdict["margin_kwh"] < 0 and verdict["min_soc"] < 0
+    assert verdict["margin_kwh"] == pytest.approx(verdict["min_soc"] * 3)
 
 
 # --- the last safety net, request ids and metrics ----------------------------------------------
@@ -249,7 +277,7 @@ def test_an_unexpected_error_is_one_logged_500_that_closes_the_connection(caplog
         raise RuntimeError("a bug")
 
     app.add_api_route("/explode", explode)
-    client = TestClient(app, raise_server_exceptions=False)
+    client = CheckedClient(app, raise_server_exceptions=False)
     with caplog.at_level(logging.INFO):
         response = client.get("/explode", headers={"X-Request-ID": "bug-report-7"})
     assert response.status_code == 500

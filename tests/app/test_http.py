@@ -3,6 +3,7 @@ credentials, odd headers, and bodies built so that refusing them costs more than
 
 from __future__ import annotations
 
+import asyncio
 import json
 import random
 import string
@@ -16,6 +17,7 @@ from app.main import create_app
 from app.settings import Settings
 from core.params import MAX_STOPS, MAX_UNKNOWN_NAMED
 from tests.app.apps import app_client
+from tests.app.invariants import CheckedClient
 from tests.app.test_hostile import metric
 
 PROBLEM = "application/problem+json"
@@ -23,7 +25,7 @@ PROBLEM = "application/problem+json"
 
 @pytest.fixture(scope="module")
 def secured() -> TestClient:
-    return TestClient(create_app(Settings(api_key="s3cret")), raise_server_exceptions=False)
+    return CheckedClient(create_app(Settings(api_key="s3cret")), raise_server_exceptions=False)
 
 
 @pytest.fixture(scope="module")
@@ -94,6 +96,47 @@ def test_a_repeated_api_key_is_a_401_in_any_order(secured, keys):
     assert response.status_code == 401
     assert "X-API-Key" in response.json()["detail"]
     assert secured.get("/v1/presets", headers={"X-API-Key": "s3cret"}).status_code == 200
+
+
+def test_without_the_key_an_upload_is_a_401_before_its_body_is_read():
+    """The audit: /v1/calibrations/csv parsed a whole multipart upload, then answered a bad one
+    with a 422, before it looked at the key."""
+    app = create_app(Settings(api_key="s3cret"))
+    sent: list[dict] = []
+
+    async def receive() -> dict:
+        raise AssertionError("the body was read")
+
+    async def send(message: dict) -> None:
+        sent.append(message)
+
+    scope = {
+        "type": "http",
+        "method": "POST",
+        "path": "/v1/calibrations/csv",
+        "raw_path": b"/v1/calibrations/csv",
+        "query_string": b"",
+        "headers": [(b"content-type", b"multipart/form-data; boundary=x")],
+        "http_version": "1.1",
+        "scheme": "http",
+        "server": ("test", 80),
+        "client": ("test", 1),
+        "root_path": "",
+    }
+    asyncio.run(app(scope, receive, send))
+    assert sent[0]["status"] == 401
+    assert dict(sent[0]["headers"])[b"www-authenticate"] == b"ApiKey"
+
+
+def test_an_unreadable_upload_says_it_is_not_multipart(secured):
+    response = secured.post(
+        "/v1/calibrations/csv",
+        content=b"--x\r\nnot a part",
+        headers={"X-API-Key": "s3cret", "content-type": "multipart/form-data; boundary=x"},
+    )
+    assert response.status_code == 422
+    assert "multipart/form-data" in response.json()["detail"]
+    assert "JSON" not in response.json()["detail"]
 
 
 @pytest.mark.parametrize("key", ["", " ", "tab\there", "caf\u00e9", "\x7f"])

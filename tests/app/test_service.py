@@ -1,8 +1,6 @@
 import json
 from pathlib import Path
 
-from fastapi.testclient import TestClient
-
 from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
 from app.jobs.schemas import JobOut
 from app.main import app, create_app
@@ -12,6 +10,7 @@ from app.schemas.simulate import SimulateResponse
 from app.schemas.studies import ScenariosResponse, SpeedSweepResponse
 from app.settings import Settings
 from core.params import PRESETS
+from tests.app.invariants import CheckedClient
 
 OPENAPI = Path(__file__).resolve().parents[2] / "openapi" / "openapi.json"
 
@@ -71,7 +70,7 @@ def test_presets_and_health(client):
 
 
 def test_api_key_when_configured():
-    secured = TestClient(create_app(Settings(api_key="s3cret")))
+    secured = CheckedClient(create_app(Settings(api_key="s3cret")))
     assert secured.get("/v1/presets").status_code == 401
     assert secured.get("/v1/presets", headers={"X-API-Key": "nope"}).status_code == 401
     assert secured.get("/v1/presets", headers={"X-API-Key": "s3cret"}).status_code == 200
@@ -85,7 +84,7 @@ def test_unknown_path_is_a_problem(client):
 
 
 def test_cors_when_configured():
-    with_cors = TestClient(create_app(Settings(cors_origins=["https://dispatch.example"])))
+    with_cors = CheckedClient(create_app(Settings(cors_origins=["https://dispatch.example"])))
     response = with_cors.options(
         "/v1/presets",
         headers={"Origin": "https://dispatch.example", "Access-Control-Request-Method": "GET"},

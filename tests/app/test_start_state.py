@@ -37,7 +37,11 @@ def test_the_rest_of_the_day_from_the_van(client):
         ({"time": "2026-07-15T12:10:00"}, "start_state.time"),  # no UTC offset
         ({"lat": 91}, "start_state.lat"),
         ({"payload_kg": 10}, "start_state.payload_kg"),
+        # the audit: 40 t aboard a van that left with 550 kg was simulated
+        ({"payload_kg": 40_000}, "start_state.payload_kg"),
         ({"driving_since_break_s": -1}, "start_state.driving_since_break_s"),
+        # the audit: the nanoseconds were cut without a word
+        ({"time": "2026-07-15T12:10:00.123456789+02:00"}, "start_state.time"),
     ],
 )
 def test_bad_start_states_are_422_naming_the_field(client, change, field):
@@ -46,6 +50,31 @@ def test_bad_start_states_are_422_naming_the_field(client, change, field):
     assert response.status_code == 422
     errors = response.json()["errors"]
     assert any(e["field"] == field for e in errors), errors
+    # a job is refused at submission as the endpoint refuses it, not 2 s later
+    job = client.post("/v1/jobs", json={"type": "plan", "request": body})
+    assert job.status_code == 422, job.text[:300]
+    assert any(e["field"] == f"request.{field}" for e in job.json()["errors"]), job.json()
+
+
+@pytest.mark.parametrize("where", ["stops", "depot"])
+def test_no_place_of_a_round_under_way_is_called_start(client, where):
+    """The audit: a stop called "start" made the tour read ["start", "start", …]."""
+    body = PLAN_EXAMPLE | {"start_state": STATE}
+    if where == "stops":
+        body["stops"] = [PLAN_EXAMPLE["stops"][0] | {"id": "start"}, *PLAN_EXAMPLE["stops"][1:]]
+        field = "stops[0].id"
+    else:
+        body["depot"] = PLAN_EXAMPLE["depot"] | {"id": "start"}
+        field = "depot.id"
+    response = client.post("/v1/plans", json=body)
+    assert response.status_code == 422
+    assert [e["field"] for e in response.json()["errors"]] == [field]
+    fleet = fleet_from_noon({}) | {"stops": body["stops"], "depot": body["depot"]}
+    refused = client.post("/v1/fleet-plans", json=fleet)
+    assert refused.status_code == 422 and refused.json()["errors"][0]["field"] == field
+    # without a start state the name is free
+    plain = {key: value for key, value in body.items() if key != "start_state"}
+    assert client.post("/v1/plans", json=plain).status_code == 200
 
 
 def fleet_from_noon(change: dict) -> dict:
@@ -86,3 +115,26 @@ def test_bad_fleet_start_states_are_422_naming_the_van(client, change, field):
     assert response.status_code == 422
     errors = response.json()["errors"]
     assert any(e["field"] == f"vehicles[1].start_state.{field}" for e in errors), errors
+
+
+def test_a_fleet_van_under_way_that_cannot_reach_the_depot_says_so(client):
+    """The one fleet route below its reserve: a van already under way too far from the depot
+    for its charge. The README promises no route below the reserve: the answer says why."""
+    body = fleet_from_noon({"soc": 0.165, "lat": 48.05, "lon": 16.10})
+    response = client.post("/v1/fleet-plans", json=body)
+    assert response.status_code == 200, response.text[:300]
+    answer = response.json()
+    stranded = {r["vehicle_id"]: r for r in answer["routes"]}["van-2"]
+    assert not stranded["battery"]["feasible"]
+    assert any("van-2 is under way with too little charge" in w for w in answer["warnings"])
+
+
+def test_reloads_under_way_are_refused_for_what_they_are(client):
+    """The audit: a van under way with max_trips 3 and more to deliver than it carries was
+    told a round with time windows does not reload."""
+    heavy = [stop | {"delivery_kg": 300} for stop in PLAN_EXAMPLE["stops"]]
+    body = PLAN_EXAMPLE | {"stops": heavy, "max_trips": 3, "start_state": STATE}
+    response = client.post("/v1/plans", json=body)
+    assert response.status_code == 422
+    message = response.json()["errors"][0]["message"]
+    assert "start_state" in message and "time windows" not in message

@@ -5,6 +5,7 @@ import pytest
 
 from app.examples import SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
 from report.paper import main as report_main
+from tests.app.apps import app_client
 
 
 def test_speed_sweep_example(client):
@@ -79,3 +80,27 @@ def test_report_cli_runs(tmp_path):
         timeout=120,
     )
     assert run.returncode == 0 and "wrote" in run.stdout
+
+
+def test_a_grid_of_week_long_rounds_is_refused_before_it_runs(client):
+    """The audit: 1,200 cells of a 5.8-day round passed the limit, which counted cell-stops
+    only. The services alone (7 stops of 20 h) make each cell at least 5.8 days: the study
+    is a 413 pointing to jobs before any simulation, and as a job a 422 naming the limit."""
+    long_stops = [
+        stop | {"service_time_s": 72_000, "door_open_s": 600}
+        for stop in SCENARIOS_EXAMPLE["plan"]["stops"][:7]
+    ]
+    body = SCENARIOS_EXAMPLE | {
+        "plan": SCENARIOS_EXAMPLE["plan"] | {"stops": long_stops},
+        "seasons": [{"name": f"s{i}", "date": "2026-03-01"} for i in range(12)],
+        "driver_aggressiveness": [0.1 * i for i in range(1, 11)],
+        "traffic_density": [0.05 + 0.09 * i for i in range(2)],
+    }
+    refused = client.post("/v1/studies/scenarios", json=body)
+    assert refused.status_code == 413, refused.text[:300]
+    assert "POST /v1/jobs" in refused.json()["detail"]
+    roomy = app_client(max_study_cell_stops=100_000, max_job_simulated_s=86_400.0 * 365)
+    job = roomy.post("/v1/jobs", json={"type": "scenarios", "request": body})
+    assert job.status_code == 422, job.text[:300]
+    assert job.json()["title"] == "Limit exceeded"
+    assert job.json()["errors"][0]["field"] == "request.seasons"

@@ -13,13 +13,13 @@ import math
 from pathlib import Path
 
 import pytest
-from fastapi.testclient import TestClient
 from playwright.sync_api import Page, expect
 from pydantic import ValidationError
 
 from app.main import create_app
 from app.settings import Settings
 from benchmarks.common import Server
+from tests.app.invariants import CheckedClient
 from tests.app.test_browser import offline_tab
 from tests.app.test_roads import monaco_plan
 
@@ -29,6 +29,8 @@ KEY = "dispatch-key"
 HEADER = "id,lat,lon,service_min,door_min,kg,window_start,window_end"
 #: A stop of 900 kg: heavier than any van's payload, so no van takes it.
 TOO_HEAVY = "pallet-of-ice"
+#: A stop id a spreadsheet would run: the CSV export keeps it text.
+FORMULA = '=HYPERLINK("http://x")'
 
 
 def vienna_round(count: int = 24) -> list[dict[str, object]]:
@@ -39,7 +41,8 @@ def vienna_round(count: int = 24) -> list[dict[str, object]]:
         angle = k * 2.399963
         stops.append(
             {
-                "id": f"shop-{k + 1:02d}",
+                # one a spreadsheet would run as a formula, exported as text
+                "id": FORMULA if k == 2 else f"shop-{k + 1:02d}",
                 "lat": round(48.208 + radius_m * math.sin(angle) / 111_000, 5),
                 "lon": round(16.372 + radius_m * math.cos(angle) / 74_000, 5),
                 "service_min": 6,
@@ -145,6 +148,8 @@ def test_a_csv_day_for_three_vans_on_the_map_and_in_the_charts(server, page, tmp
     assert len(rows) == served and {r["vehicle_id"] for r in rows} == {
         r["vehicle_id"] for r in routes
     }
+    assert [r["stop_id"] for r in rows if FORMULA in r["stop_id"]] == [f"'{FORMULA}"]
+    assert not any(cell[:1] in "=+@" for r in rows for cell in r.values())
     with tab.expect_download() as download:
         tab.get_by_test_id("export-geojson").click()
     features = json.loads(Path(download.value.path()).read_text())["features"]
@@ -227,7 +232,7 @@ def test_the_service_names_a_bad_field_and_the_key_is_sent(server, page, tmp_pat
 
 def test_the_page_allows_only_its_own_host_and_the_tiles():
     tiles = "https://{s}.tiles.example/{z}/{x}/{y}.png"
-    client = TestClient(create_app(Settings(tile_url=tiles)))  # no lifespan: no workers
+    client = CheckedClient(create_app(Settings(tile_url=tiles)))  # no lifespan: no workers
     page = client.get("/viewer")
     policy = page.headers["content-security-policy"]
     assert "script-src 'self';" in policy and "connect-src 'self';" in policy
@@ -236,6 +241,11 @@ def test_the_page_allows_only_its_own_host_and_the_tiles():
     script = client.get("/viewer/static/viewer.js")
     assert script.status_code == 200 and "text/javascript" in script.headers["content-type"]
     assert client.get("/viewer/static/secrets.py").status_code == 404
+    # the audit: a 10 kB name echoed whole, and answers a browser might sniff
+    missing = client.get("/viewer/static/" + "a" * 10_000 + ".js")
+    assert missing.status_code == 404 and len(missing.content) < 1_000
+    for answer in (page, script, missing):
+        assert answer.headers["x-content-type-options"] == "nosniff"
     assert "(/viewer)" in client.get("/openapi.json").json()["info"]["description"]
     with pytest.raises(ValidationError):
         Settings(tile_url="javascript:alert(1)")
