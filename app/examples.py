@@ -182,12 +182,13 @@ SCENARIOS_EXAMPLE: dict[str, Any] = {
 def _calibration_example() -> dict[str, Any]:
     """Two ten-minute trips at 1 Hz (stop-and-go, then a fast road) of the real reefer van
     with more drag and auxiliaries than its preset, as its telematics would log them: the
-    battery power of each second, to the watt."""
+    battery power of each second, to the watt, with its sensor's noise, and the outside
+    temperature."""
     import datetime as dt
 
     import numpy as np
 
-    from core.params import PRESETS, Location
+    from core.params import PRESETS, Location, Weather
     from core.physics.simulate import CONSUMERS, simulate
 
     van = PRESETS["ev-van-3.5t-reefer"].van()
@@ -209,8 +210,14 @@ def _calibration_example() -> dict[str, Any]:
     trips = []
     for k, speed in enumerate([pattern(13.0, 30, 15), pattern(25.0, 120, 5)]):
         begins = start + dt.timedelta(hours=k)
-        result = simulate(np.array(speed), 1.0, begins, location, truth)
+        outside_c = 24.0 + k  # the van's own thermometer, logged with the power
+        weather = Weather(t_min_c=outside_c, t_max_c=outside_c)
+        result = simulate(np.array(speed), 1.0, begins, location, truth, weather=weather)
         power = np.sum([result.power_w[c] for c in CONSUMERS], axis=0)
+        # the current sensor's noise: 1 % of the power and 30 W, a fixed seed per trip
+        power = power + (0.01 * np.abs(power) + 30.0) * np.random.default_rng(k).normal(
+            size=power.size
+        )
         logged = np.concatenate([[power[0]], power])
         trips.append(
             {
@@ -219,6 +226,7 @@ def _calibration_example() -> dict[str, Any]:
                 "location": {"lat": 48.21, "lon": 16.37},
                 "time_s": list(range(len(speed))),
                 "speed_mps": speed,
+                "ambient_c": [outside_c] * len(speed),
                 "battery_power_w": [round(float(w)) for w in logged],
             }
         )

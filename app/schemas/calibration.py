@@ -96,12 +96,23 @@ class FittedParameterOut(ApiModel):
 
     value: float = Field(..., description="The fitted value.")
     initial: float = Field(..., description="The starting van's value.")
-    std_error: float = Field(..., description="Standard error (Gauss–Newton, at the solution).")
-    ci95: tuple[float, float] = Field(..., description="95 % interval [low, high] (Student's t).")
+    std_error: float | None = Field(
+        ...,
+        description="Standard error at the solution: a sandwich with the Newey–West covariance "
+        "of the residuals (robust to noise that grows with the power and is correlated in "
+        "time); null where no interval is given.",
+    )
+    ci95: tuple[float, float] | None = Field(
+        ...,
+        description="95 % interval [low, high] (fixed-b critical value, Kiefer & Vogelsang "
+        "2005), within the parameter's bounds; null where the data cannot give one: the trips "
+        "do not move the parameter, or it would absorb the cab's and box's draw of trips "
+        "without ambient_c (a warning says so).",
+    )
     identifiable: bool = Field(
         ...,
-        description="Whether the data tell it apart: its interval narrower than its value and "
-        "no correlation above 0.95 with another fitted parameter.",
+        description="Whether the data tell it apart: an interval given, narrower than its "
+        "value, and no correlation above 0.95 with another fitted parameter.",
     )
 
 

@@ -10,10 +10,15 @@ measured power is compared with each step's mean simulated power, per measured c
 channel weighted by its own spread so that a watt of the cab counts as much as a watt of the
 drive train relative to what each varies by.
 
-Uncertainty comes from the Jacobian at the solution (Gauss–Newton covariance, residual variance
-from the fit): a standard error, a 95 % interval (Student's t), and whether the data tell the
-parameter apart — not when its interval is wider than the value itself, nor when it correlates
-above :data:`MAX_CORRELATION` with another fitted parameter.
+Uncertainty is a sandwich at the solution: the Jacobian's ``(JᵀJ)⁻¹`` around the long-run
+covariance of the residuals' scores (Newey–West within each measured series), so that noise
+which grows with the power and is correlated in time — what telematics logs carry — does not
+make the intervals too narrow; the 95 % interval uses the fixed-b critical value of that
+estimator (Kiefer & Vogelsang 2005). A parameter is identifiable when its interval is
+narrower than its value and it correlates at most :data:`MAX_CORRELATION` with every other
+fitted parameter. No interval is given where the data cannot give one: a parameter the
+trips do not move, or one that would absorb the cab's and the box's draw of trips measured
+without their outside temperature.
 """
 
 from __future__ import annotations
@@ -27,7 +32,7 @@ from typing import Literal
 import numpy as np
 from annotated_types import Ge, Gt, Le, Lt
 from pydantic import Field
-from scipy import optimize, special
+from scipy import optimize
 
 from core.arrays import FloatArray
 from core.exceptions import InvalidParameterError
@@ -156,8 +161,8 @@ class FittedParameter:
     name: str
     value: float
     initial: float
-    std_error: float
-    ci95: tuple[float, float]
+    std_error: float | None
+    ci95: tuple[float, float] | None
     identifiable: bool
 
 
@@ -216,8 +221,13 @@ def calibrate(
         raise InvalidParameterError("at least one trip must be fitted (role 'fit')", "trips")
     solution = _solve(van, fitted, chosen)
     best = _with(van, chosen, solution.x)
-    result = _uncertainty(van, chosen, solution)
-    warnings = _warnings(result.correlation, chosen, fitted) + _stretched(best, resampled)
+    unmeasured = _unmeasured(chosen, fitted)
+    result = _uncertainty(chosen, solution, fitted, unmeasured)
+    warnings = (
+        _warnings(result.correlation, chosen, fitted)
+        + _temperature_warnings(fitted, unmeasured)
+        + _stretched(best, resampled)
+    )
     trips_fit = [_trip_fit(best, r, "fit") for r in fitted]
     if held_out:
         validation = [_trip_fit(best, r, "validation") for r in held_out]
@@ -522,36 +532,133 @@ class _Uncertainty:
     correlation: FloatArray
 
 
+#: The HAC estimator's bandwidth as a share of each measured series (fixed-b, Kiefer &
+#: Vogelsang 2005): with its critical value (:func:`fixed_b_quantile`) the intervals keep
+#: their coverage whether the noise is independent or strongly correlated in time.
+HAC_BANDWIDTH_SHARE = 0.15
+
+
+def fixed_b_quantile(b: float) -> float:
+    """The 97.5 % quantile of the t-statistic with a Bartlett HAC variance of bandwidth share
+    ``b`` (Kiefer, N. M. & Vogelsang, T. J., "A new asymptotic theory for
+    heteroskedasticity-autocorrelation robust tests", *Econometric Theory* 21 (2005)
+    1130–1164, their cubic fit of the two-sided 5 % critical values); 1.96 at ``b = 0``."""
+    return 1.96 + 2.9694 * b + 0.4160 * b**2 - 0.5324 * b**3
+
+
+def hac_scores(scores: FloatArray, series: Sequence[tuple[int, int]]) -> FloatArray:
+    """The long-run covariance of the residuals' scores ``g_t = J_t·r_t`` (m × p) [–]:
+    Newey–West (Bartlett weights ``1 − l/(L+1)``) within each measured series (a trip's
+    channel, rows ``a:b``), the series independent of each other, the bandwidth ``L`` a share
+    :data:`HAC_BANDWIDTH_SHARE` of each series. Newey, W. K. & West, K. D., *Econometrica* 55
+    (1987) 703–708: robust to noise that grows with the power and is correlated in time."""
+    p = scores.shape[1]
+    covariance = np.zeros((p, p))
+    for a, b in series:
+        g = scores[a:b]
+        covariance += g.T @ g
+        lags = min(math.ceil(HAC_BANDWIDTH_SHARE * (b - a)), b - a - 1)
+        for lag in range(1, lags + 1):
+            shifted = g[lag:].T @ g[:-lag]
+            covariance += (1 - lag / (lags + 1)) * (shifted + shifted.T)
+    return covariance
+
+
+def _series(trips: Sequence[_Resampled]) -> list[tuple[int, int]]:
+    """Where each trip's channel lies in the stacked residuals (:func:`_residuals`)."""
+    bounds, at = [], 0
+    for trip in trips:
+        for measured in trip.measured_w.values():
+            bounds.append((at, at + measured.size))
+            at += measured.size
+    return bounds
+
+
 def _uncertainty(
-    van: VanParams, chosen: Sequence[_Bounded], solution: optimize.OptimizeResult
+    chosen: Sequence[_Bounded],
+    solution: optimize.OptimizeResult,
+    trips: Sequence[_Resampled],
+    unmeasured: set[str],
 ) -> _Uncertainty:
-    """Gauss–Newton covariance at the solution: (JᵀJ)⁻¹ times the residual variance."""
+    """The sandwich covariance at the solution, ``(JᵀJ)⁻¹·S·(JᵀJ)⁻¹`` with ``S`` the HAC
+    covariance of the scores (:func:`hac_scores`), and the fixed-b quantile for the 95 %
+    intervals. No interval where the data cannot give one: a parameter the Jacobian does not
+    see, or one in ``unmeasured`` (it would absorb what the trips did not measure)."""
     jac = np.asarray(solution.jac, dtype=float)
     m, p = jac.shape
-    dof = max(m - p, 1)
-    variance = float(np.sum(solution.fun**2)) / dof
-    covariance = np.linalg.pinv(jac.T @ jac) * variance
+    bread = np.linalg.pinv(jac.T @ jac)
+    scores = jac * np.asarray(solution.fun, dtype=float)[:, None]
+    covariance = bread @ hac_scores(scores, _series(trips)) @ bread * m / max(m - p, 1)
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    # Whether the data tell two parameters apart is the design's (the Jacobian's columns),
+    # not the noise's: the correlation of (JᵀJ)⁻¹.
+    spread = np.sqrt(np.maximum(np.diag(bread), 0.0))
     with np.errstate(invalid="ignore", divide="ignore"):
-        correlation = covariance / np.outer(std, std)
+        correlation = bread / np.outer(spread, spread)
     correlation = np.nan_to_num(correlation, nan=1.0)
-    # Student's t quantile; scipy.stats would cost every worker 0.7 s at start.
-    t = float(special.stdtrit(dof, 0.975))
+    quantile = fixed_b_quantile(HAC_BANDWIDTH_SHARE)
+    seen = np.abs(jac).sum(axis=0) > 0
     singular = np.linalg.matrix_rank(jac) < p
     fitted = []
     for k, parameter in enumerate(chosen):
         value = float(solution.x[k]) * parameter.scale
         error = float(std[k]) * parameter.scale
         apart = all(abs(correlation[k, j]) <= MAX_CORRELATION for j in range(p) if j != k)
-        identifiable = (not singular) and apart and error * t < abs(value)
-        low = max(value - t * error, parameter.low)
-        high = min(value + t * error, parameter.high)
+        given = bool(seen[k]) and not singular and parameter.name not in unmeasured
+        identifiable = given and apart and error * quantile < abs(value)
+        interval = (
+            (
+                max(value - quantile * error, parameter.low),
+                min(value + quantile * error, parameter.high),
+            )
+            if given
+            else None
+        )
         fitted.append(
             FittedParameter(
-                parameter.name, value, parameter.initial, error, (low, high), identifiable
+                parameter.name,
+                value,
+                parameter.initial,
+                error if given else None,
+                interval,
+                identifiable,
             )
         )
     return _Uncertainty(fitted, correlation)
+
+
+#: The consumers whose draw follows the outside temperature (the cab's HVAC, the box's
+#: unit), and the parameters that would absorb an error in it: a constant draw, the box.
+TEMPERATURE_CONSUMERS = ("cabin", "refrigeration")
+ABSORB_TEMPERATURE = ("auxiliaries_power_w", "wall_heat_transfer_w_m2k", "cop")
+
+
+def _unmeasured(chosen: Sequence[_Bounded], trips: Sequence[_Resampled]) -> set[str]:
+    """The parameters no interval is given for: those that absorb the cab's and the box's
+    draw when a trip whose measured power includes them has no outside temperature (the
+    climatology stands in, and its error goes into them)."""
+    blind = [
+        t
+        for t in trips
+        if t.trip.ambient_c is None
+        and any(set(CHANNELS[c]) & set(TEMPERATURE_CONSUMERS) for c in t.measured_w)
+    ]
+    return {p.name for p in chosen if p.name in ABSORB_TEMPERATURE} if blind else set()
+
+
+def _temperature_warnings(trips: Sequence[_Resampled], unmeasured: set[str]) -> list[str]:
+    """What the fit could not tell for want of the outside temperature."""
+    if not unmeasured:
+        return []
+    blind = [t.trip.id for t in trips if t.trip.ambient_c is None]
+    names = ", ".join(sorted(unmeasured))
+    return [
+        f"trip{'s' * (len(blind) > 1)} {', '.join(repr(i) for i in blind[:5])} "
+        f"{'have' if len(blind) > 1 else 'has'} no ambient_c: the cab's and the box's draw come "
+        f"from the climatology, and its error goes into {names} — not identifiable from these "
+        "trips, no interval given; the other intervals assume the climatology's temperatures "
+        "(measure ambient_c)"
+    ]
 
 
 def _warnings(

@@ -96,20 +96,33 @@ def field_problem(path: str, body: Any, schema: dict[str, Any] | None) -> str | 
     return None
 
 
-def _request_schema(method: str, path: str) -> dict[str, Any] | None:
-    for template, operations in _openapi()["paths"].items():
-        pattern = "^" + re.sub(r"\{[^}]+\}", "[^/]+", template) + "$"
-        if re.match(pattern, path):
-            body = operations.get(method.lower(), {}).get("requestBody", {})
-            content = body.get("content", {}).get("application/json")
-            return None if content is None else content["schema"]
+def _template(path: str) -> str | None:
+    for template in _openapi()["paths"]:
+        if re.fullmatch(re.sub(r"\{[^}]+\}", "[^/]+", template), path):
+            return template
     return None
 
 
+def _request_schema(method: str, template: str | None) -> dict[str, Any] | None:
+    if template is None:
+        return None
+    body = _openapi()["paths"][template].get(method.lower(), {}).get("requestBody", {})
+    content = body.get("content", {}).get("application/json")
+    return None if content is None else content["schema"]
+
+
 def check_problem_fields(
-    method: str, path: str, body: Any, headers: Any, answer: dict[str, Any]
+    method: str, url: httpx.URL, body: Any, headers: Any, answer: dict[str, Any]
 ) -> None:
-    schema = _request_schema(method, path)
+    template = _template(url.path)
+    for error in answer.get("errors", []):
+        field = error["field"]
+        where, _, name = field.partition(".")
+        if where == "path":
+            assert template is not None and f"{{{name}}}" in template, f"{field}: not in the path"
+        elif where == "query":
+            assert name in url.params, f"{field}: no such query parameter sent"
+    schema = _request_schema(method, template)
     if schema is None:
         return
     pairs = headers.items() if isinstance(headers, dict) else (headers or [])
@@ -120,6 +133,8 @@ def check_problem_fields(
         field = error["field"]
         if field.startswith("header."):
             assert field.removeprefix("header.") in sent_headers, f"{field}: no such header sent"
+            continue
+        if field.startswith(("path.", "query.")):
             continue
         problem = field_problem(field, body, schema)
         assert problem is None, f"422 of {method} {path} names a field nobody sent: {problem}"
@@ -163,7 +178,8 @@ class CheckedClient(TestClient):
 
     def request(self, method: str, url: Any, **kwargs: Any) -> httpx.Response:  # type: ignore[override]
         response = super().request(method, url, **kwargs)
-        path = httpx.URL(str(url)).path
+        sent = httpx.URL(str(url), params=kwargs.get("params"))
+        path = sent.path
         body = kwargs.get("json")
         if body is None and isinstance(kwargs.get("content"), (str, bytes)):
             try:
@@ -172,7 +188,7 @@ class CheckedClient(TestClient):
                 body = None
         is_json = response.headers.get("content-type", "").endswith("json")
         if response.status_code == 422 and body is not None and is_json:
-            check_problem_fields(method, path, body, kwargs.get("headers"), response.json())
+            check_problem_fields(method, sent, body, kwargs.get("headers"), response.json())
         elif response.status_code == 200 and is_json and path.startswith("/v1/"):
             check_answer(response.json())
         return response

@@ -66,7 +66,8 @@ def bad(change) -> dict:
         (lambda t: t["battery_power_w"].pop(), "trips[1].battery_power_w"),
         (lambda t: t["battery_power_w"].__setitem__(9, "lots"), "trips[1].battery_power_w[9]"),
         (lambda t: t.update(time_s=t["time_s"][:50], speed_mps=t["speed_mps"][:50],
-                            battery_power_w=t["battery_power_w"][:50]), "trips[1].time_s"),
+                            battery_power_w=t["battery_power_w"][:50],
+                            ambient_c=t["ambient_c"][:50]), "trips[1].time_s"),
         (lambda t: t.pop("battery_power_w"), "trips[1]"),
         # the trust issue's audit: a 500, or a 422 naming a field without its trip
         (lambda t: t["battery_power_w"].__setitem__(5, 1e308), "trips[1].battery_power_w[5]"),
@@ -148,7 +149,7 @@ def as_csv(body: dict, delimiter: str = ",") -> tuple[dict, list]:
     """The form of POST /v1/calibrations/csv: the trips' metadata as JSON text, each trip's
     columns as a file ``<id>.csv`` (with semicolons, decimal commas, as a spreadsheet in much
     of Europe exports it)."""
-    columns = ("time_s", "speed_mps", "battery_power_w")
+    columns = ("time_s", "speed_mps", "battery_power_w", "ambient_c")
     meta = copy.deepcopy(body)
     files = []
     for trip in meta["trips"]:

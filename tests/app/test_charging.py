@@ -109,6 +109,24 @@ def test_bad_chargers_and_curves_are_422_naming_the_field(client, change, field)
     assert any(e["field"] == field for e in response.json()["errors"]), response.json()["errors"]
 
 
+def test_a_charging_curve_too_slow_for_the_day_is_answered_and_said(client):
+    """The audit: a valid 0.1 kW curve was a 422 naming ``duration_s`` (a 400 h charge broke a
+    bound of the spell): a slow charge is not the client's error. No charge longer than a
+    day is planned; the verdict and a warning say why the battery does not last."""
+    slow = [{"soc": 0.0, "power_kw": 0.1}, {"soc": 1.0, "power_kw": 0.1}]
+    body = CHARGING_PLAN_EXAMPLE | {
+        "battery": CHARGING_PLAN_EXAMPLE["battery"] | {"charging_curve": slow}
+    }
+    response = client.post("/v1/plans", json=body)
+    assert response.status_code == 200, response.text[:300]
+    answer = response.json()
+    assert not answer["battery"]["feasible"] and answer["charges"] == []
+    assert any(
+        "charging at the depot charger would take" in w and "0.1 kW" in w
+        for w in answer["warnings"]
+    ), answer["warnings"]
+
+
 def test_the_map_shows_each_charge_at_the_depot(client):
     response = client.post(
         "/v1/plans", json=CHARGING_PLAN_EXAMPLE, headers={"Accept": "application/geo+json"}

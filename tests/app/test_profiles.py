@@ -220,6 +220,9 @@ def test_put_creates_then_replaces_and_delete_forgets(client):
         ("post", "", {"name": "ok", "colour": "white"}, 422, "colour"),
         ("put", "/right-name", {"name": "other-name"}, 422, "name"),
         ("put", "/bad%20name", {}, 422, "path.name"),
+        # a URL path reads these as steps: the profile could never be reached again
+        ("post", "", {"name": "."}, 422, "name"),
+        ("post", "", {"name": ".."}, 422, "name"),
     ],
 )  # fmt: skip
 def test_bad_profiles_are_refused_naming_the_field(client, method, path, body, status, field):
@@ -286,3 +289,35 @@ def test_a_profile_from_a_calibration_differs_from_its_van_only_in_what_was_fitt
         assert changed == {k for k in expected if fitted[section][k] != start[section][k]}
     for name, value in fitted["vehicle"].items():
         assert made["vehicle"][name] == value
+
+
+def test_put_and_delete_racing_on_one_name_never_fail():
+    """The audit: 5 of 120 PUTs racing DELETEs of the same profile on PostgreSQL were 500s
+    (the row went between the read and the update). Ten threads, PostgreSQL as the machines
+    run it: every answer is one of the documented ones, and the profile ends as one PUT
+    wrote it or deleted."""
+    import concurrent.futures
+
+    with own_services() as env:
+        server = Server(
+            {"COLDROUTE_DATABASE_URL": env["COLDROUTE_DATABASE_URL"], "COLDROUTE_WORKERS": "1"}
+        ).start()
+        try:
+            path = f"{server.url}/v1/vehicle-profiles/raced"
+
+            def one(k: int) -> int:
+                if k % 2:
+                    return httpx.delete(path, timeout=30).status_code
+                body = {"vehicle": {"preset": "paper-generic", "mass_kg": 2000.0 + k}}
+                return httpx.put(path, json=body, timeout=30).status_code
+
+            with concurrent.futures.ThreadPoolExecutor(10) as pool:
+                statuses = list(pool.map(one, range(120)))
+            final = httpx.get(path, timeout=30)
+        finally:
+            server.close()
+    assert set(statuses) <= {200, 201, 204, 404, 409}, statuses
+    assert statuses.count(200) + statuses.count(201) >= 50
+    assert final.status_code in (200, 404)
+    if final.status_code == 200:
+        assert final.json()["vehicle"]["mass_kg"] in {2000.0 + k for k in range(0, 120, 2)}

@@ -5,6 +5,8 @@ data cannot tell drag from rolling resistance, and refuses bad trips naming colu
 from __future__ import annotations
 
 import datetime as dt
+from dataclasses import replace
+from functools import cache
 from typing import get_args
 
 import numpy as np
@@ -20,7 +22,7 @@ from core.calibration.fit import (
     check_trip,
 )
 from core.exceptions import InvalidParameterError
-from core.params import PRESETS, Location, VanParams
+from core.params import PRESETS, Location, VanParams, Weather
 from core.physics.cycles import load_cycle_csv
 from core.physics.simulate import simulate
 from tests.conftest import SHARED
@@ -52,10 +54,16 @@ def as_logged(step_power_w: np.ndarray, n: int) -> np.ndarray:
     return np.concatenate([[step_power_w[0]], step_power_w])[:n]
 
 
-def measured_trip(van: VanParams, name: str, k: int, rng, noise_w: float) -> MeasuredTrip:
+def measured_trip(
+    van: VanParams, name: str, k: int, rng, noise_w: float, thermometer: bool = True
+) -> MeasuredTrip:
+    """Cycle ``name`` driven by ``van`` on a day at 18 + 2·k °C, its battery power logged with
+    independent noise of ``noise_w``, and the outside temperature unless not ``thermometer``."""
     drive = cycle(name)
     start = START + dt.timedelta(hours=k)
-    result = simulate(drive.speed_mps, drive.dt_s, start, VIENNA, van)
+    outside_c = 18.0 + 2 * k
+    weather = Weather(t_min_c=outside_c, t_max_c=outside_c)
+    result = simulate(drive.speed_mps, drive.dt_s, start, VIENNA, van, weather=weather)
     battery_w = np.sum([result.power_w[c] for c in CHANNELS["battery_power_w"]], axis=0)
     n = drive.speed_mps.size
     return MeasuredTrip(
@@ -65,6 +73,7 @@ def measured_trip(van: VanParams, name: str, k: int, rng, noise_w: float) -> Mea
         time_s=np.arange(n) * drive.dt_s,
         speed_mps=drive.speed_mps,
         measured_w={"battery_power_w": as_logged(battery_w, n) + rng.normal(0, noise_w, n)},
+        ambient_c=np.full(n, outside_c) if thermometer else None,
     )
 
 
@@ -254,3 +263,90 @@ def test_bad_parameters_are_refused_by_name(parameters, field, rule):
     with pytest.raises(InvalidParameterError) as error:
         calibrate(van, [good_trip()], parameters)
     assert error.value.field == field and rule in error.value.message
+
+
+#: The trust issue's van: the reefer with more drag and rolling resistance than its preset.
+TRUTH = {
+    "drag_coefficient": 0.41,
+    "rolling_resistance_coefficient": 0.0095,
+    "drivetrain_efficiency": 0.87,
+    "regen_efficiency": 0.75,
+    "auxiliaries_power_w": 620.0,
+}
+
+
+@cache
+def _clean_trip(van: VanParams, name: str, k: int) -> MeasuredTrip:
+    return measured_trip(van, name, k, np.random.default_rng(0), noise_w=0.0)
+
+
+def noisy_trips(van: VanParams, seed: int, seconds: int = 600) -> list[MeasuredTrip]:
+    """Ten minutes of four cycles (the WLTC twice, on another day), logged with noise as
+    telematics log it: 3 % of the
+    power plus 150 W, correlated in time (AR(1), ρ = 0.8: a current sensor's drift and the
+    logger's filtering), the last trip held out for validation."""
+    rng = np.random.default_rng(seed)
+    trips = []
+    for k, name in enumerate(["wltc_3b", "hwfet", "udds", "wltc_3b"]):
+        whole = _clean_trip(van, name, k)
+        n = seconds + 1
+        clean = whole.measured_w["battery_power_w"][:n]
+        shocks = rng.normal(size=n) * np.sqrt(1 - 0.8**2)
+        unit = np.empty(n)
+        unit[0] = rng.normal()
+        for t in range(1, n):
+            unit[t] = 0.8 * unit[t - 1] + shocks[t]
+        trips.append(
+            MeasuredTrip(
+                id=whole.id,
+                start=whole.start,
+                location=whole.location,
+                time_s=whole.time_s[:n],
+                speed_mps=whole.speed_mps[:n],
+                measured_w={"battery_power_w": clean + (0.03 * np.abs(clean) + 150.0) * unit},
+                ambient_c=whole.ambient_c[:n],
+            )
+        )
+    return trips
+
+
+def test_the_95_percent_intervals_cover_the_truth_under_telematics_noise():
+    """The trust issue: with noise that grows with the power, the Gauss–Newton intervals
+    excluded the true drag and rolling resistance (5 of 40 missed where 2 would be nominal;
+    under correlated noise about half). 200 fits of trips with known parameters and noise of
+    3 % of the power and 150 W, AR(1) ρ = 0.8: the 95 % intervals cover the truth in 90–98 %
+    of them (a binomial 95 % over 1,000 intervals lies within ±1.4 %)."""
+    preset = PRESETS["ev-van-3.5t-reefer"].van()
+    truth = preset.model_copy(update={"vehicle": preset.vehicle.model_copy(update=TRUTH)})
+    covered: dict[str, list[bool]] = {name: [] for name in TRUTH}
+    for seed in range(200):
+        trips = noisy_trips(truth, seed)
+        trips[-1] = replace(trips[-1], role="validation")  # no cross-validation: one fit each
+        fit = calibrate(preset, trips, [FitParameter(name=name) for name in TRUTH])
+        for parameter in fit.parameters:
+            low, high = parameter.ci95
+            covered[parameter.name].append(low <= TRUTH[parameter.name] <= high)
+    share = {name: float(np.mean(hits)) for name, hits in covered.items()}
+    pooled = float(np.mean([hit for hits in covered.values() for hit in hits]))
+    assert 0.90 <= pooled <= 0.98, share
+    assert all(0.86 <= s <= 0.99 for s in share.values()), share
+
+
+def test_without_the_outside_temperature_the_auxiliaries_get_no_interval():
+    """The trust issue: trips without ambient_c gave intervals that missed drag and the
+    auxiliaries, and nothing said why. The cab's and the box's draw then come from the
+    climatology, and its error goes into the constant draw: no interval, and a warning."""
+    truth = PRESETS["ev-van-3.5t-reefer"].van()
+    rng = np.random.default_rng(3)
+    names = ["udds", "hwfet", "us06"]
+    trips = [measured_trip(truth, n, k, rng, 100.0, thermometer=False) for k, n in enumerate(names)]
+    fit = calibrate(truth, trips, [])
+    by_name = {p.name: p for p in fit.parameters}
+    auxiliaries = by_name["auxiliaries_power_w"]
+    assert auxiliaries.ci95 is None and auxiliaries.std_error is None
+    assert not auxiliaries.identifiable
+    assert any("no ambient_c" in w and "auxiliaries_power_w" in w for w in fit.warnings)
+    assert by_name["drag_coefficient"].ci95 is not None
+    # with the thermometer's log the same trips give every interval
+    logged = [measured_trip(truth, n, k, rng, 100.0) for k, n in enumerate(names)]
+    assert all(p.ci95 is not None for p in calibrate(truth, logged, []).parameters)
