@@ -137,7 +137,7 @@ def check_problem_fields(
         if field.startswith(("path.", "query.")):
             continue
         problem = field_problem(field, body, schema)
-        assert problem is None, f"422 of {method} {path} names a field nobody sent: {problem}"
+        assert problem is None, f"422 of {method} {url.path} names a field nobody sent: {problem}"
 
 
 def check_battery(route: dict[str, Any]) -> None:
