@@ -210,17 +210,31 @@ class Executor:
         finally:
             self._slots().release()
 
-    async def start(self, fn: Callable[..., T], *args: Any) -> Future[T]:
-        """Wait (without deadline) for a worker and start ``fn(*args)`` on it; the worker's
-        future, which :meth:`finish` awaits and ``cancel()`` stops (a job)."""
-        await self._acquire(None, None)
-        future = self._schedule(fn, args)
-        future.add_done_callback(lambda _: self._slots().release())
-        return future
+    async def reserve(self, wait_s: float) -> bool:
+        """Hold a free worker for a job, waiting at most ``wait_s`` [s] in line with the
+        requests; whether one is held (then :meth:`start` it, or :meth:`release` it). Not
+        while the server shuts down: a job must not be claimed that could not run."""
+        if self.draining:
+            return False
+        try:
+            await asyncio.wait_for(self._slots().acquire(), wait_s)
+        except TimeoutError:
+            return False
+        if self.draining:  # the shutdown began while this waited
+            self.release()
+            return False
+        return True
 
-    async def finish(self, future: Future[T]) -> T:
-        """The result of a future :meth:`start` returned."""
-        return await self._await(future)
+    def release(self) -> None:
+        """Give back a worker :meth:`reserve` held."""
+        self._slots().release()
+
+    def start(self, fn: Callable[..., T], *args: Any) -> Future[T]:
+        """Start ``fn(*args)`` on the worker :meth:`reserve` held; the worker's future, which
+        ``cancel()`` stops (a job). The worker is free again when it ends."""
+        future = self._schedule(fn, args)
+        future.add_done_callback(lambda _: self.release())
+        return future
 
     async def _acquire(
         self, disconnected: Callable[[], Awaitable[bool]] | None, deadline_s: float | None

@@ -62,13 +62,20 @@ class LocalRunner:
                 await asyncio.wait_for(self._queued.wait(), LOOK_EVERY_S)
 
     async def _take(self) -> bool:
-        """Claim the next job and start it; whether there was one."""
-        if self.executor.draining:  # a job claimed now could not finish
+        """Claim the next job and start it; whether there was one. A worker is held before
+        the claim: a job is never running here without a worker to run it (busy workers, or a
+        shutdown, would leave it claimed and idle)."""
+        if not await self.executor.reserve(LOOK_EVERY_S):
             return False
-        job = await asyncio.to_thread(self.lifecycle.claim_next)
+        try:
+            job = await asyncio.to_thread(self.lifecycle.claim_next)
+        except BaseException:
+            self.executor.release()
+            raise
         if job is None:
+            self.executor.release()
             return False
-        future = await self.executor.start(run_job, job.type, job.request, self.settings)
+        future = self.executor.start(run_job, job.type, job.request, self.settings)
         watch = asyncio.create_task(asyncio.to_thread(self.lifecycle.watch, job, future))
         self.watching.add(watch)
         watch.add_done_callback(self._ended)

@@ -22,6 +22,7 @@ import redis
 from app.examples import PLAN_EXAMPLE
 from app.jobs.celery_app import celery_for, visibility_timeout_s
 from app.jobs.lifecycle import JOB_EXTRA_TIME_S
+from app.jobs.store import JobStore
 from app.settings import Settings
 from benchmarks.common import Server
 from tests.app.serving import alive, children, long_plan
@@ -225,6 +226,36 @@ def test_sigterm_stops_claiming_requeues_what_cannot_finish_and_costs_no_attempt
     assert [job["status"] for job in done] == ["succeeded"] * 3
     # The interrupted run was not counted, and nothing was claimed during the drain.
     assert [job["attempts"] for job in done] == [1, 1, 1]
+
+
+def test_a_job_is_not_claimed_while_requests_hold_every_worker():
+    """The fault audit: the built-in runner claimed a job (attempts 1) while both workers ran
+    synchronous requests, then waited for a worker; a SIGTERM left it ``running`` with no
+    owner — with SQLite and no restart, for ever. A worker is held before a claim: the job
+    stays queued, unclaimed and uncounted, and is still queued after the shutdown."""
+    import concurrent.futures
+
+    with tempfile.TemporaryDirectory() as folder:
+        env = FAST | {"COLDROUTE_WORKERS": "1", "COLDROUTE_SHUTDOWN_GRACE_S": "1"}
+        server = Server(env, database_dir=Path(folder)).start()
+        try:
+            with concurrent.futures.ThreadPoolExecutor(1) as pool:
+                busy = pool.submit(
+                    httpx.post, f"{server.url}/v1/plans", json=long_plan(300, 8), timeout=60
+                )
+                time.sleep(1.0)  # the only worker is solving it
+                job_id = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+                time.sleep(2.0)  # the runner has looked several times meanwhile
+                waiting = status_of(server.url, job_id)
+                server.process.send_signal(signal.SIGTERM)
+                server.process.wait(timeout=20)
+                assert busy.result().status_code in (200, 503)
+        finally:
+            server.close()
+        store = JobStore(f"sqlite:///{folder}/jobs.db")
+        left = store.get(job_id)
+    assert waiting["status"] == "queued" and waiting["attempts"] == 0, waiting
+    assert left is not None and left.status == "queued" and left.attempts == 0, left
 
 
 def test_sigterm_with_no_request_in_flight_lets_a_short_job_finish():
