@@ -17,6 +17,7 @@ from __future__ import annotations
 from functools import lru_cache
 
 from celery import Celery, Task
+from sqlalchemy.exc import OperationalError
 
 from app.execution import WorkerPool
 from app.jobs.lifecycle import JOB_EXTRA_TIME_S, Lifecycle, time_limit_s
@@ -26,6 +27,8 @@ from app.settings import Settings, get_settings
 
 #: The name of the task that runs a job.
 TASK = "coldroute.run_job"
+#: How soon a message whose job could not be claimed (the database away) is taken again [s].
+DATABASE_RETRY_S = 2
 
 
 def celery_for(settings: Settings) -> Celery:
@@ -81,7 +84,12 @@ def _run_job(task: Task, job_id: str) -> str:
     """
     settings = get_settings()
     lifecycle = Lifecycle(store_for(settings.database_url), settings, task.request.id)
-    job = lifecycle.claim(job_id)
+    try:
+        job = lifecycle.claim(job_id)
+    except OperationalError as error:
+        # The database is away: this message comes back in a moment, not when the servers
+        # resend it (minutes); the attempt is not counted, as nothing was claimed.
+        raise task.retry(countdown=DATABASE_RETRY_S, max_retries=None, exc=error) from None
     if job is None:
         return "not queued (done, cancelled, waiting for a retry or running elsewhere)"
     future = _pool(settings.workers).schedule(

@@ -15,11 +15,13 @@ import os
 import socket
 import time
 import uuid
+from collections.abc import Callable
 from concurrent.futures import CancelledError, Future
 from dataclasses import dataclass
 from typing import Any, Literal
 
 from pebble import ProcessExpired
+from sqlalchemy.exc import OperationalError
 
 from app.errors import core_problem, problem_body, service_problem
 from app.execution import UnavailableError
@@ -32,6 +34,9 @@ _log = logging.getLogger("coldroute.jobs")
 JOB_EXTRA_TIME_S = 120.0
 #: How often the housekeeping runs (stale jobs, retention, undispatched jobs) [s].
 SWEEP_EVERY_S = 2.0
+#: Longest a run waits for the database to record how it ended [s]; beyond, its heartbeat is
+#: long stale and the job runs again.
+DATABASE_PATIENCE_S = 600.0
 #: How a watched run ended.
 Ending = Literal["succeeded", "failed", "cancelled", "retrying", "interrupted"]
 
@@ -93,6 +98,7 @@ class Lifecycle:
         self.settings = settings
         self.runner = runner
         self.policy = RetryPolicy(settings.job_max_attempts, tuple(settings.job_retry_backoff_s))
+        self._reachable_since: float | None = None
 
     def claim_next(self) -> JobView | None:
         """The oldest due job, now running here."""
@@ -104,7 +110,9 @@ class Lifecycle:
 
     def watch(self, job: JobView, future: Future[Any]) -> Ending:
         """Wait for the run of ``job`` in ``future`` (a worker process), beating its heartbeat,
-        stopping it when it is cancelled or runs out of time, and record how it ended."""
+        stopping it when it is cancelled or runs out of time, and record how it ended. The
+        database may be away meanwhile: the run goes on, and what it records waits for the
+        database (:meth:`_stored`) — an outage costs no run."""
         limit_s = time_limit_s(job)
         deadline = time.monotonic() + limit_s
         while True:
@@ -114,42 +122,73 @@ class Lifecycle:
                 if future.done():  # the pool's own time limit ended the run
                     return self._out_of_time(job, limit_s)
             except CancelledError:  # the server shuts down: another run, not counted
-                self.store.requeue(job.id, self.runner, count=False)
+                self._stored(lambda: self.store.requeue(job.id, self.runner, count=False))
                 return "interrupted"
             except Exception as error:
                 return self._failed(job, error)
             else:
-                self.store.finish(job.id, self.runner, result=result)
+                self._stored(lambda: self.store.finish(job.id, self.runner, result=result))
                 return "succeeded"
             if time.monotonic() > deadline:
                 future.cancel()
                 return self._out_of_time(job, limit_s)
-            self.store.heartbeat([job.id], self.runner)
-            if self.store.cancelled_among([job.id]):
+            try:
+                self.store.heartbeat([job.id], self.runner)
+                cancelled = self.store.cancelled_among([job.id])
+            except OperationalError as error:  # the database is away: beat again later
+                _log.warning("job %s: no heartbeat (%s); the run goes on", job.id, error)
+                continue
+            if cancelled:
                 future.cancel()  # Pebble stops the worker process
                 return "cancelled"
 
+    def _stored(self, write: Callable[[], object]) -> None:
+        """Record an ending, waiting out a database that is away (every heartbeat period, up
+        to :data:`DATABASE_PATIENCE_S`; then the job's heartbeat is stale and it runs again)."""
+        given_up = time.monotonic() + DATABASE_PATIENCE_S
+        while True:
+            try:
+                write()
+                return
+            except OperationalError as error:
+                if time.monotonic() > given_up:
+                    raise
+                _log.warning("the database is away (%s); the job's ending waits for it", error)
+                time.sleep(self.settings.job_heartbeat_s)
+
     def _out_of_time(self, job: JobView, limit_s: float) -> Ending:
         problem = problem_body(504, "Time limit exceeded", f"the job ran longer than {limit_s:g} s")
-        self.store.finish(job.id, self.runner, error=problem)
+        self._stored(lambda: self.store.finish(job.id, self.runner, error=problem))
         return "failed"
 
     def _failed(self, job: JobView, error: Exception) -> Ending:
         problem, retryable = failure(error)
         wait_s = self.policy.retry_after_s(job.attempts) if retryable else None
         if wait_s is not None:
-            self.store.requeue(job.id, self.runner, after_s=wait_s)
+            self._stored(lambda: self.store.requeue(job.id, self.runner, after_s=wait_s))
             _log.warning("job %s failed (%s); again in %g s", job.id, problem["detail"], wait_s)
             return "retrying"
-        self.store.finish(job.id, self.runner, error=problem)
+        self._stored(lambda: self.store.finish(job.id, self.runner, error=problem))
         return "failed"
 
     def sweep(self) -> list[JobView]:
         """Requeue the jobs whose runner went silent (fail those out of attempts) and purge the
-        expired; the requeued jobs."""
+        expired; the requeued jobs. Silence is judged only once this sweeper has reached the
+        database for ``job_stale_after_s`` without a break: after an outage (or at start) the
+        runners that kept running get their heartbeat in first, and lose no attempt."""
         settings = self.settings
+        try:
+            stale = self.store.stale(settings.job_stale_after_s)
+        except OperationalError:
+            self._reachable_since = None
+            raise
+        moment = time.monotonic()
+        if self._reachable_since is None:
+            self._reachable_since = moment
+        if moment - self._reachable_since < settings.job_stale_after_s:
+            stale = []
         requeued = []
-        for job in self.store.stale(settings.job_stale_after_s):
+        for job in stale:
             if job.attempts >= settings.job_max_attempts:
                 self.store.fail_exhausted(job.id, settings.job_max_attempts, _exhausted(job))
             elif self.store.requeue(job.id, job.runner):

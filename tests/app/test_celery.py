@@ -65,7 +65,7 @@ class Worker:
     """``celery -A app.jobs.worker worker --pool=threads`` with one worker process (as
     ``make worker``), in its own process group."""
 
-    def __init__(self, env: dict[str, str], name: str) -> None:
+    def __init__(self, env: dict[str, str], name: str, concurrency: int = 1) -> None:
         inherited = {k: v for k, v in os.environ.items() if not k.startswith("COLDROUTE_")}
         self.process = subprocess.Popen(
             [
@@ -76,7 +76,7 @@ class Worker:
                 "app.jobs.worker",
                 "worker",
                 "--pool=threads",
-                "--concurrency=1",
+                f"--concurrency={concurrency}",
                 "--loglevel=WARNING",
                 "--without-gossip",
                 "--without-mingle",

@@ -28,6 +28,7 @@ from benchmarks.common import Server
 from tests.app.serving import alive, children, long_plan
 from tests.app.test_celery import Worker, own_services
 from tests.app.test_jobs import FAST, submit, wait_for
+from tests.utils.tcp_proxy import TcpProxy
 
 #: Loopback only, and nothing kept on disk.
 REDIS_SERVER = ["redis-server", "--bind", "127.0.0.1", "--save", "", "--appendonly", "no"]
@@ -256,6 +257,46 @@ def test_a_job_is_not_claimed_while_requests_hold_every_worker():
         left = store.get(job_id)
     assert waiting["status"] == "queued" and waiting["attempts"] == 0, waiting
     assert left is not None and left.status == "queued" and left.attempts == 0, left
+
+
+def test_a_database_outage_costs_no_attempt_and_delays_nothing_beyond_it():
+    """The fault audit: with PostgreSQL away, a Celery worker kept taking messages, failed to
+    claim their jobs and dropped them: queued jobs ran only when the servers resent them,
+    80 s after the database came back, and the jobs running through the outage each lost an
+    attempt. PostgreSQL (the machines' own) is cut off behind a proxy for 8 s while a job
+    runs and three wait: every job runs once, within seconds of the database's return."""
+    proxy = TcpProxy(("127.0.0.1", 5432))
+    try:
+        with own_services() as env:
+            env = env | {
+                "COLDROUTE_DATABASE_URL": env["COLDROUTE_DATABASE_URL"].replace(
+                    "127.0.0.1:5432", f"127.0.0.1:{proxy.port}"
+                )
+            }
+            server = Server(env).start()
+            worker = Worker(env, "outage", concurrency=2)
+            try:
+                running = submit(server.url, {"type": "plan", "request": long_plan(150, 3)})
+                running_id = running.json()["id"]
+                wait_for(server.url, running_id, states=("running",), timeout=60)
+                queued = [
+                    submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+                    for _ in range(3)
+                ]
+                proxy.cut()
+                time.sleep(8)
+                proxy.mend()
+                back = time.monotonic()
+                done = [wait_for(server.url, job, timeout=90) for job in [running_id, *queued]]
+                took_s = time.monotonic() - back
+            finally:
+                worker.stop()
+                server.close()
+    finally:
+        proxy.close()
+    assert [job["status"] for job in done] == ["succeeded"] * 4, done
+    assert [job["attempts"] for job in done] == [1] * 4
+    assert took_s < 30, took_s  # the servers' resend would have taken 80 s
 
 
 def test_sigterm_with_no_request_in_flight_lets_a_short_job_finish():
