@@ -18,6 +18,7 @@ import uuid
 from collections.abc import Callable
 from concurrent.futures import CancelledError, Future
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Literal
 
 from pebble import ProcessExpired
@@ -127,7 +128,7 @@ class Lifecycle:
             except Exception as error:
                 return self._failed(job, error)
             else:
-                self._stored(lambda: self.store.finish(job.id, self.runner, result=result))
+                self._stored(partial(self.store.finish, job.id, self.runner, result=result))
                 return "succeeded"
             if time.monotonic() > deadline:
                 future.cancel()
