@@ -7,6 +7,7 @@ from benchmarks import (
     bench_planner,
     bench_roads,
     bench_serving,
+    bench_soak,
     bench_studies,
     evrptw,
 )
@@ -20,5 +21,6 @@ for module in (
     bench_fleet,
     evrptw,
     bench_serving,
+    bench_soak,
 ):
     module.main()
