@@ -44,8 +44,8 @@ PLAN_EXAMPLE: dict[str, Any] = {
 }
 
 # A long summer day of one van: 40 stops spread over 15 km around the centre (a golden-angle
-# spiral), about 70 kWh with the refrigeration at 31 °C — far more than its 40 kWh. The depot's
-# 22 kW charger brings it back twice in the afternoon to charge what the rest needs.
+# spiral), about twice its 40 kWh with the refrigeration at 31 °C. The depot's 22 kW charger
+# brings it back to charge what the rest needs (its figures: app/response_examples.json).
 _GOLDEN_ANGLE = math.pi * (3 - math.sqrt(5))
 CHARGING_PLAN_EXAMPLE: dict[str, Any] = {
     "date": "2026-07-15",
@@ -240,6 +240,61 @@ def _calibration_example() -> dict[str, Any]:
 CALIBRATION_EXAMPLE: dict[str, Any] = _calibration_example()
 
 
+#: The request examples of /v1/plans and /v1/fleet-plans as Swagger shows them: name →
+#: (summary, body). Their descriptions are their answers' figures (:func:`describe`), recorded
+#: by ``make openapi`` and checked against a fresh run by the tests: they cannot drift.
+PLAN_EXAMPLES: dict[str, tuple[str, dict[str, Any]]] = {
+    "vienna-8-stops": ("A summer morning round in Vienna", PLAN_EXAMPLE),
+    "vienna-40-stops-depot-charger": (
+        "A summer day longer than the battery: it charges at the depot",
+        CHARGING_PLAN_EXAMPLE,
+    ),
+    "vienna-40-stops-chargers-on-the-way": (
+        "The same day with chargers on the way: it stops at the fast one",
+        EN_ROUTE_CHARGING_EXAMPLE,
+    ),
+}
+FLEET_EXAMPLES: dict[str, tuple[str, dict[str, Any]]] = {
+    "vienna-two-vans": (
+        "Two vans, shop receiving windows, a summer day in Vienna",
+        FLEET_PLAN_EXAMPLE,
+    ),
+}
+
+
+def describe(answer: dict[str, Any]) -> str:
+    """The figures of a plan's or a fleet plan's answer, as its example's description says
+    them."""
+    if "routes" in answer:
+        served = sum(len(route["stops"]) for route in answer["routes"])
+        left = len(answer["unassigned"])
+        totals = answer["totals"]
+        vans = len(answer["routes"])
+        return (
+            f"{vans} van{'s' * (vans != 1)} serve{'s' * (vans == 1)} {served} of "
+            f"{served + left} stops: "
+            f"{totals['distance_m'] / 1000:.1f} km and {totals['energy_kwh']['total']:.1f} kWh "
+            "in all."
+        )
+    energy = answer["totals"]["energy_kwh"]
+    battery = answer["battery"]
+    charges = answer["charges"]
+    where = sorted({c["charger_id"] for c in charges})
+    charged = (
+        "no charge"
+        if not charges
+        else f"{len(charges)} charge{'s' * (len(charges) > 1)} at "
+        + " and ".join("the depot" if w == "depot" else f"'{w}'" for w in where)
+        + f" ({sum(c['minutes'] for c in charges):.0f} min)"
+    )
+    back = answer["legs"][-1]["arrive"][11:16]
+    return (
+        f"{energy['total']:.1f} kWh in all ({energy['refrigeration']:.1f} of them for the "
+        f"refrigeration) on a {battery['usable_capacity_kwh']:g} kWh battery; {charged}; back "
+        f"at {back}, its lowest charge {battery['min_soc']:.0%}."
+    )
+
+
 def record() -> dict[str, Any]:
     """The answers of the examples above from a real run (``python -m app.examples`` writes
     them to app/response_examples.json, which Swagger shows)."""
@@ -271,7 +326,23 @@ def record() -> dict[str, Any]:
         attempts=1,
         result=planned,
     )
+    descriptions = {
+        name: describe(
+            plan.plan_response(
+                plan.run_plan(PlanRequest.model_validate(body), settings)
+            ).model_dump(mode="json")
+        )
+        for name, (_, body) in PLAN_EXAMPLES.items()
+    } | {
+        name: describe(
+            fleet_plan.fleet_response(
+                fleet_plan.run_fleet_plan(FleetPlanRequest.model_validate(body), settings)
+            ).model_dump(mode="json")
+        )
+        for name, (_, body) in FLEET_EXAMPLES.items()
+    }
     return {
+        "descriptions": descriptions,
         "plan": plan_json,
         "fleet_plan": fleet_plan.fleet_response(
             fleet_plan.run_fleet_plan(FleetPlanRequest.model_validate(FLEET_PLAN_EXAMPLE), settings)

@@ -60,7 +60,9 @@ gives the energy of one speed trace. `POST /v1/calibrations` fits the model to a
 trips (JSON, or CSV files at `/v1/calibrations/csv`), and `/v1/vehicle-profiles` keeps your vans by
 name — from a preset with changes or from a calibration — for any request's
 `"vehicle": {"profile": …}`. Units are in the field names (`_m`, `_s`, `_kwh`, `_c`...).
-Errors are `application/problem+json` (RFC 9457).
+Errors are `application/problem+json` (RFC 9457). The same request gives the same answer, byte
+for byte but the timing fields (`solver.runtime_s`): searches stop on their work (`work_s`,
+seeded by `seed`), and `time_limit_s` only caps them (`solver.stopped_by` says when it did).
 
 **[The plan viewer](/viewer)** plans a day from a CSV of stops and shows it: the routes on a map,
 the state of charge, the energy per consumer and the box temperature over the day."""

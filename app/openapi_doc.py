@@ -62,6 +62,18 @@ EXAMPLES = {
 }
 
 
+def request_examples(examples: dict[str, tuple[str, dict[str, Any]]]) -> dict[str, Any]:
+    """Swagger's request examples: each with its summary and, as its description, the figures
+    of its answer as ``make openapi`` recorded them (``app.examples.describe``)."""
+    recorded = json.loads(RESPONSE_EXAMPLES.read_text()) if RESPONSE_EXAMPLES.exists() else {}
+    described = recorded.get("descriptions", {})
+    return {
+        name: {"summary": summary, "value": body}
+        | ({"description": f"Answers: {described[name]}"} if name in described else {})
+        for name, (summary, body) in examples.items()
+    }
+
+
 def finish(schema: dict[str, Any], extra_models: list[type[BaseModel]]) -> dict[str, Any]:
     """Complete FastAPI's document (in place) and return it."""
     components = schema.setdefault("components", {})

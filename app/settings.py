@@ -72,7 +72,10 @@ class Settings(BaseSettings):
         "1 Hz, some ten seconds of work); beyond, a 413 points to jobs, which have no such bound.",
     )
     max_time_limit_s: float = Field(
-        10.0, gt=0, description="Cap on a request's solver time_limit_s [s]."
+        120.0,
+        gt=0,
+        description="Cap on a request's time_limit_s [s]: a search it stops says so "
+        "(stopped_by: time_limit).",
     )
     max_job_time_limit_s: float = Field(
         600.0, gt=0, description="Cap on a job's solver time_limit_s [s] (jobs may solve longer)."

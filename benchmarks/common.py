@@ -55,17 +55,19 @@ def euc_2d_matrix(path: Path) -> np.ndarray:
     return np.floor(distance + 0.5).astype(np.int64)
 
 
-def _burn(stop: Any) -> None:
+def _burn(stop: Any, niceness: int) -> None:
+    os.nice(niceness)
     while not stop.is_set():
         sum(i * i for i in range(10_000))
 
 
 @contextmanager
-def busy_core() -> Iterator[None]:
-    """Another process keeps one core fully busy for the duration (a second client's solve)."""
+def busy_core(niceness: int = 0) -> Iterator[None]:
+    """Another process keeps one core fully busy for the duration (a second client's solve;
+    at the service's workers' ``niceness``, another request's solve)."""
     context = multiprocessing.get_context("spawn")
     stop = context.Event()
-    burner = context.Process(target=_burn, args=(stop,), daemon=True)
+    burner = context.Process(target=_burn, args=(stop, niceness), daemon=True)
     burner.start()
     time.sleep(0.3)
     try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from app import connectors
 from app.operations.answers import attribution, energy
-from app.operations.limits import check_round, time_limit_s
+from app.operations.limits import check_round, search_limits
 from app.operations.plan import plan_response
 from app.operations.vans import van_of
 from app.schemas.fleet import (
@@ -41,8 +41,7 @@ def fleet_problem(request: FleetPlanRequest, settings: Settings) -> FleetProblem
             raise error.under(f"vehicles[{index}]") from None
         vehicles.append(FleetVehicle(**fields_of(vehicle, ShiftFields), van=van))
     return FleetProblem(
-        **fields_of(request, FleetFields)
-        | {"time_limit_s": time_limit_s(request.time_limit_s, settings)},
+        **fields_of(request, FleetFields) | search_limits(request, settings),
         vehicles=vehicles,
     )
 
@@ -87,6 +86,7 @@ def fleet_response(
             objective=result.objective,
             objective_value=result.objective_value,
             runtime_s=result.runtime_s,
+            stopped_by=result.stopped_by,
             verification_rounds=result.verification_rounds,
         ),
         timezone=result.timezone,

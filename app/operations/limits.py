@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from app.settings import Settings
 from core.exceptions import LimitExceededError
-from core.planning.model import RoundFields
+from core.planning.model import WORK_SHARE, FleetFields, PlanFields, RoundFields
 
 
 def check_round(request: RoundFields, settings: Settings) -> None:
@@ -16,6 +18,10 @@ def check_round(request: RoundFields, settings: Settings) -> None:
         )
 
 
-def time_limit_s(requested_s: float, settings: Settings) -> float:
-    """A request's solver budget within the server's cap [s]."""
-    return min(requested_s, settings.max_time_limit_s)
+def search_limits(request: PlanFields | FleetFields, settings: Settings) -> dict[str, Any]:
+    """A request's search within the server's cap: its time limit capped [s], its work from
+    the limit the request asked for — so the same request does the same search whatever the
+    server's cap, and a cap that stops it says so."""
+    requested_s = request.time_limit_s
+    work_s = request.work_s if request.work_s is not None else WORK_SHARE * requested_s
+    return {"time_limit_s": min(requested_s, settings.max_time_limit_s), "work_s": work_s}

@@ -6,7 +6,7 @@ from typing import Any
 
 from app import connectors
 from app.operations.answers import attribution, battery, box, energy, weather
-from app.operations.limits import check_round, time_limit_s
+from app.operations.limits import check_round, search_limits
 from app.operations.vans import van_of
 from app.schemas.base import EnergySeries, EnergyShare, LineString, Point
 from app.schemas.plans import (
@@ -32,8 +32,7 @@ def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
     """The core problem of a plan request, within the server's limits."""
     check_round(request, settings)
     return PlanProblem(
-        **fields_of(request, PlanFields)
-        | {"time_limit_s": time_limit_s(request.time_limit_s, settings)},
+        **fields_of(request, PlanFields) | search_limits(request, settings),
         van=van_of(request, settings),
     )
 
@@ -95,6 +94,8 @@ def plan_response(
             objective=result.objective,
             objective_value=result.solved.objective_value,
             runtime_s=result.solved.runtime_s,
+            stopped_by=result.solved.stopped_by,
+            proven=list(result.solved.proven),
         ),
         distance_source=result.distance_source,
         warnings=result.warnings,

@@ -7,7 +7,8 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 
 from app.deps import ExecutorDep, SettingsDep
-from app.examples import FLEET_PLAN_EXAMPLE
+from app.examples import FLEET_EXAMPLES
+from app.openapi_doc import request_examples
 from app.operations.fleet_plan import answer, run_fleet_plan
 from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
 
@@ -23,14 +24,7 @@ router = APIRouter(tags=["fleet"])
 async def create_fleet_plan(
     request: Annotated[
         FleetPlanRequest,
-        Body(
-            openapi_examples={
-                "vienna-two-vans": {
-                    "summary": "Two vans, shop receiving windows, a summer day in Vienna",
-                    "value": FLEET_PLAN_EXAMPLE,
-                }
-            }
-        ),
+        Body(openapi_examples=request_examples(FLEET_EXAMPLES)),
     ],
     http: Request,
     settings: SettingsDep,
@@ -40,8 +34,9 @@ async def create_fleet_plan(
     windows, shifts, payload and each van's battery as constraints) and simulates every route's day
     in full: the charge never falls below a van's reserve, service starts inside a window, every van
     is back before its shift ends, deliveries fit the payload. A route the simulation rejects is
-    tightened and solved again within `time_limit_s`; stops no van can serve are listed in
-    `unassigned` with their reason. Solved in a worker process, as plans are."""
+    tightened and solved again (its work `work_s`, `time_limit_s` the cap); stops no van can
+    serve are listed in `unassigned` with their reason. Solved in a worker process, as plans
+    are."""
     result = await pool.run(run_fleet_plan, request, settings, disconnected=http.is_disconnected)
     http.app.state.metrics.solve.observe(result.runtime_s)
     return answer(request, result)

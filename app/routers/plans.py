@@ -8,7 +8,8 @@ from fastapi import APIRouter, Body, Header, Request
 from fastapi.responses import JSONResponse
 
 from app.deps import ExecutorDep, SettingsDep
-from app.examples import CHARGING_PLAN_EXAMPLE, EN_ROUTE_CHARGING_EXAMPLE, PLAN_EXAMPLE
+from app.examples import PLAN_EXAMPLES
+from app.openapi_doc import request_examples
 from app.operations.plan import answer, plan_geojson, run_plan
 from app.schemas.plans import PlanRequest, PlanResponse
 
@@ -54,22 +55,7 @@ def wants_geojson(accept: str | None) -> bool:
 async def create_plan(
     request: Annotated[
         PlanRequest,
-        Body(
-            openapi_examples={
-                "vienna-8-stops": {
-                    "summary": "A summer morning round in Vienna",
-                    "value": PLAN_EXAMPLE,
-                },
-                "vienna-40-stops-depot-charger": {
-                    "summary": "A summer day longer than the battery: it charges at the depot",
-                    "value": CHARGING_PLAN_EXAMPLE,
-                },
-                "vienna-40-stops-chargers-on-the-way": {
-                    "summary": "The same day with chargers on the way: it stops at the fast one",
-                    "value": EN_ROUTE_CHARGING_EXAMPLE,
-                },
-            }
-        ),
+        Body(openapi_examples=request_examples(PLAN_EXAMPLES)),
     ],
     http: Request,
     settings: SettingsDep,

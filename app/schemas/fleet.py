@@ -8,6 +8,7 @@ from app.schemas.base import ApiModel, AttributionOut, DistanceSourceOut, Energy
 from app.schemas.plans import AnswerOptions, PlanResponse
 from core.params import Objective
 from core.planning.model import FleetFields, ShiftFields, UnassignedReason, vehicles_field
+from core.routing.effort import SearchEnd
 from core.routing.tsp import SolverStatus
 
 
@@ -37,7 +38,7 @@ class UnassignedOut(ApiModel):
         description="time_window (no van reaches it inside a window), capacity (no payload "
         "left or too heavy), battery (the charge would fall below a reserve), shift (no van "
         "back in time), unreachable (no road) or time_limit (the search ran out of time before "
-        "it placed the stop; it may fit with a longer time_limit_s).",
+        "it placed the stop; it may fit with more work: work_s or a longer time_limit_s).",
     )
     detail: str = Field(..., description="Why, in a sentence.")
 
@@ -60,13 +61,22 @@ class FleetSolverOut(ApiModel):
     """How the fleet search ended."""
 
     status: SolverStatus = Field(
-        ..., description="feasible: the best found in the time limit (no proof of optimality)."
+        ..., description="feasible: the best found (a fleet's search proves nothing)."
+    )
+    stopped_by: SearchEnd = Field(
+        "work",
+        description="work: the search did all its work (work_s); time_limit: time_limit_s "
+        "stopped it first — the answer may then differ on a retry (a warning says so).",
     )
     objective: Objective = Field(..., description="What the routes minimised.")
     objective_value: float = Field(
         ..., description="Of every route together, in m, s or Wh (estimate)."
     )
-    runtime_s: float = Field(..., description="Time the search and the verification took [s].")
+    runtime_s: float = Field(
+        ...,
+        description="Time the search and the verification took [s]. A timing field: it differs "
+        "between runs.",
+    )
     verification_rounds: int = Field(
         ...,
         description="How often the routes were simulated in full; above 1 when a simulation "

@@ -22,7 +22,8 @@ from app.schemas.base import (
     WeatherOut,
 )
 from core.params import Objective, StreetTypeName
-from core.planning.model import PlanFields
+from core.planning.model import PlanFields, ProvenPart
+from core.routing.effort import SearchEnd
 from core.routing.tsp import SolverStatus
 
 
@@ -160,18 +161,32 @@ class Totals(ApiModel):
 
 
 class SolverOut(ApiModel):
-    """How the tour search ended."""
+    """How the search ended."""
 
     status: SolverStatus = Field(
         ...,
-        description="optimal (proven over all arcs), feasible (the best found in the time "
-        "limit) or fixed_order (keep_order).",
+        description="optimal: the whole answer is proven optimal for its objective — the order "
+        "proven over every arc, and no charge or reload placed by a heuristic; feasible: the "
+        "best found (see proven for the parts that carry a proof); fixed_order: keep_order.",
     )
     objective: Objective = Field(
         ..., description="What the tour minimised: distance, duration or energy."
     )
     objective_value: float = Field(..., description="Of the tour, in m, s or Wh (estimate).")
-    runtime_s: float = Field(..., description="Time the tour search took [s].")
+    runtime_s: float = Field(
+        ..., description="Time the search took [s]. A timing field: it differs between runs."
+    )
+    stopped_by: SearchEnd = Field(
+        "work",
+        description="work: the search did all its work (work_s); proof: it proved its optimum "
+        "first; time_limit: time_limit_s stopped it first — the answer may then differ on a "
+        "retry (a warning says so). The same request gives the same answer unless time_limit.",
+    )
+    proven: list[ProvenPart] = Field(
+        default_factory=list,
+        description="The parts of the answer that carry a proof: order (the stops' order is "
+        "the optimum of the round trip) — also when charges or reloads were placed after it.",
+    )
 
 
 class DayProfileOut(ApiModel):

@@ -66,8 +66,8 @@ def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[Unass
     if not refusals:  # every van could take it by the estimates: the search ran out of time
         return (
             "time_limit",
-            "the search ended at its time limit before it found a place for it on a route; a "
-            "longer time_limit_s (or a job) finds one",
+            "the search's work (work_s) or its time limit ended before it found a place for it "
+            "on a route; more work (work_s, a longer time_limit_s, or a job) may find one",
         )
     reason = _most_shared(refusals)
     return reason, _FULL_DETAIL[reason]

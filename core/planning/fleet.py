@@ -19,8 +19,12 @@ the full simulation of its day.
    reason (:mod:`core.planning.explain`) — never a route reported feasible that the simulation
    says is not.
 4. With chargers (the depot's, or on the way), the stops left out for their battery are then
-   served by vans that charge where they can (:mod:`core.planning.fleet_charging`), in the
-   share :data:`CHARGING_SHARE` of the budget kept for it.
+   served by vans that charge where they can (:mod:`core.planning.fleet_charging`).
+
+Every step is bounded by work, not by the clock (:mod:`core.routing.effort`): the solves by
+their share of the request's work, the verification by :data:`MAX_RESOLVES` re-solves, the
+charging by the places it tries. The request's time limit only caps them, and the answer says
+when it did (``stopped_by``).
 """
 
 from __future__ import annotations
@@ -50,6 +54,7 @@ from core.planning.model import (
     TripFields,
     Unassigned,
     check_places,
+    cut_short,
     fields_of,
 )
 from core.planning.repair import Repaired, fitting, repair
@@ -58,20 +63,19 @@ from core.planning.solver_input import routing_input
 from core.planning.start_state import START_ID, check_start, check_start_id, under_way
 from core.planning.timeline import client_legs_too_fast, drive_time_s
 from core.planning.verify import Failure, route_failure, traced_seconds
+from core.routing.effort import Effort, SearchEnd, combined
 from core.routing.geo import build_legs
 from core.routing.roads import RememberingRouter, RoadRouter
 from core.routing.vrp import solve_routes
 
-#: Share of the remaining budget one solve may take (the rest verifies and re-solves).
-SOLVE_SHARE = 0.95
-#: Budget below which no new solve starts [s].
-MIN_SOLVE_S = 0.05
+#: Share of the work the first solve has; each re-solve after a failed verification has
+#: :data:`RESOLVE_SHARE`, at most :data:`MAX_RESOLVES` times.
+FIRST_SOLVE_SHARE = 0.6
+RESOLVE_SHARE = 0.1
+MAX_RESOLVES = 4
 #: A tightened energy budget is cut this much below the simulated need, so the next
 #: solution does not land on the edge again.
 TIGHTEN_MARGIN = 0.98
-#: Share of the budget kept for serving the stops the search left out with charging, when the
-#: fleet has chargers.
-CHARGING_SHARE = 0.4
 #: Stops whose arcs are driven before the first solve to learn the simulation's driving times.
 CALIBRATION_STOPS = 12
 
@@ -94,6 +98,7 @@ def plan_fleet(
         An hourly forecast for the day, as in :func:`core.planning.round.plan`.
     """
     started = time.perf_counter()
+    effort = problem.effort(problem.time_limit_s)
     shifts, timezone_name = check_fleet(problem)
     under_way = [k for k, v in enumerate(problem.vehicles) if v.start_state is not None]
     positions = [
@@ -134,13 +139,12 @@ def plan_fleet(
         (too_fast,) if too_fast else (),
     )
     remembering = None if router is None else RememberingRouter(router)
-    deadline = started + problem.time_limit_s
     charging = problem.depot.charger is not None or bool(problem.chargers)
     routed = search(
         fleet_day(shifts, scene, remembering, starts),
         problem.minimize_vehicles,
-        deadline - problem.time_limit_s * CHARGING_SHARE if charging else deadline,
-        deadline if charging else None,
+        effort,
+        charging,
     )
     routes = routed.stamped(time.perf_counter() - started)
     plans = [route.plan for route in routes]
@@ -155,10 +159,16 @@ def plan_fleet(
         objective=problem.objective,
         objective_value=routed.objective_value,
         runtime_s=time.perf_counter() - started,
+        stopped_by=routed.ended,
         verification_rounds=routed.verification_rounds,
         timezone=timezone_name,
         distance_source=legs.source,
-        warnings=[*day_weather[1], *routed.warnings, *_payload_short(problem, routed.unassigned)],
+        warnings=[
+            *day_weather[1],
+            *routed.warnings,
+            *_payload_short(problem, routed.unassigned),
+            *cut_short(routed.ended),
+        ],
     )
 
 
@@ -245,11 +255,21 @@ class Routed:
     verification_rounds: int
     objective_value: float
     warnings: list[str] = field(default_factory=list)
+    ended: SearchEnd = "work"
 
     def stamped(self, runtime_s: float) -> list[FleetRoute]:
-        """The routes with the search's whole run time [s] on each plan."""
+        """The routes with the search's whole run time [s] and how it stopped on each plan
+        (a fleet's search proves nothing: feasible)."""
         return [
-            replace(r, plan=replace(r.plan, solved=replace(r.plan.solved, runtime_s=runtime_s)))
+            replace(
+                r,
+                plan=replace(
+                    r.plan,
+                    solved=replace(
+                        r.plan.solved, runtime_s=runtime_s, stopped_by=self.ended, proven=()
+                    ),
+                ),
+            )
             for r in self.routes
         ]
 
@@ -364,12 +384,12 @@ def _kind(day: FleetDay, v: int) -> str:
 
 
 def search(
-    day: FleetDay, minimize_vehicles: bool, deadline: float, charging_until: float | None = None
+    day: FleetDay, minimize_vehicles: bool, effort: Effort, charging: bool = False
 ) -> Routed:
-    """Solve and verify until every route holds or ``deadline`` (a ``time.perf_counter``
-    value); ``minimize_vehicles``: fewer vans first, then the objective. With
-    ``charging_until``, the stops then left out for their battery are served by vans that
-    charge, until that moment (:mod:`core.planning.fleet_charging`)."""
+    """Solve and verify until every route holds or :data:`MAX_RESOLVES` re-solves are spent,
+    each solve its share of ``effort``'s work; ``minimize_vehicles``: fewer vans first, then
+    the objective. With ``charging``, the stops then left out for their battery are served by
+    vans that charge (:mod:`core.planning.fleet_charging`)."""
     times = LearnedTimes(day.duration_s, day.finite, day.horizon_s)
     calibrate(day, times)
     budgets = [
@@ -380,15 +400,19 @@ def search(
     results: dict[int, PlanResult] = {}
     failures: dict[int, Failure] = {}
     initial: list[list[int]] | None = None
+    ends: list[SearchEnd] = []
     rounds = 0
-    while True:
-        remaining = deadline - time.perf_counter()
-        if rounds and remaining < MIN_SOLVE_S:
+    while rounds <= MAX_RESOLVES:
+        if rounds and effort.out_of_time():
+            ends.append("time_limit")
             break
         rules = Feasibility(day, times.matrix(), budgets)
-        budget_s = max(remaining * SOLVE_SHARE, MIN_SOLVE_S)
-        outcome = solve_routes(routing_input(rules, minimize_vehicles), budget_s, initial)
+        share = FIRST_SOLVE_SHARE if not rounds else RESOLVE_SHARE
+        outcome = solve_routes(
+            routing_input(rules, minimize_vehicles), effort.share(share), initial
+        )
         rounds += 1
+        ends.append(outcome.ended if outcome is not None else "work")
         routes = outcome.routes if outcome is not None else [[] for _ in day.vans]
         results = {v: day.simulate(v, route) for v, route in enumerate(routes) if route}
         for v, result in results.items():
@@ -422,10 +446,11 @@ def search(
         for node in day.stop_nodes
         if node not in served
     ]
-    if charging_until is not None:
-        routes, results, unassigned = serve_with_charging(
-            day, routes, results, unassigned, minimize_vehicles, charging_until
+    if charging:
+        routes, results, unassigned, charged = serve_with_charging(
+            day, routes, results, unassigned, minimize_vehicles, effort
         )
+        ends.append(charged)
     for v in day.vans:  # a van under way with no stop left drives back to the depot
         if day.starts[v] and not routes[v]:
             results[v] = day.simulate(v, [])
@@ -439,4 +464,5 @@ def search(
         unassigned=unassigned,
         verification_rounds=rounds,
         objective_value=sum(day.estimates[v].route_cost(r) for v, r in enumerate(routes) if r),
+        ended=combined(ends),
     )

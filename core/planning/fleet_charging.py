@@ -10,14 +10,15 @@ charges it had: every later window and the shift's end kept, the charge points f
 between the other vans' charges). The first that holds — fewer charges by the estimates
 first, then what the objective gains, a van already driving before a new one when the fleet
 is to be small — takes the stop; its charges are booked on their charge points. A stop
-no van can take so is left out as before, its detail saying that charging did not help.
+no van can take so is left out as before, its detail saying that charging did not help (or,
+when the work's tries, :data:`TRIES_PER_S` per reference second, ran out first, that it was
+not tried everywhere).
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import math
-import time
 from dataclasses import dataclass, field, replace
 
 from core.params import ChargePoint
@@ -27,10 +28,14 @@ from core.planning.recharge import Busy, visits_of
 from core.planning.scene import charge_points
 from core.planning.timeline import ChargeVisit
 from core.planning.verify import route_failure
+from core.routing.effort import Effort, SearchEnd
 from core.routing.vrp import trips_tidied
 
 #: Places in each van's route a left-out stop is tried at, cheapest by distance first.
 POSITIONS_TRIED = 3
+#: Tries per reference second of work: each simulates a van's day with its charges fitted
+#: (0.05–0.1 s on the reference machine for days of 20–40 stops).
+TRIES_PER_S = 10.0
 
 
 @dataclass
@@ -84,22 +89,31 @@ def serve_with_charging(
     results: dict[int, PlanResult],
     unassigned: list[Unassigned],
     minimize_vehicles: bool,
-    deadline: float,
-) -> tuple[list[list[int]], dict[int, PlanResult], list[Unassigned]]:
+    effort: Effort,
+) -> tuple[list[list[int]], dict[int, PlanResult], list[Unassigned], SearchEnd]:
     """The fleet's routes (stops per van), their simulations and the stops left out, with the
     stops left out for their battery served by vans that charge where they can; the rest of
-    ``unassigned`` as it was."""
+    ``unassigned`` as it was; and how the tries ended: ``effort``'s work is
+    :data:`TRIES_PER_S` tries per second of it, over the candidate places
+    (:data:`POSITIONS_TRIED` per van) of the stops in turn; its deadline may cut them short."""
     places = day.scene.places
     bookings = Bookings(charge_points(day.shifts[0].problem, places))
     place_of = {place.id: k for k, place in enumerate(places)}
     served: set[int] = set()
+    untried: set[int] = set()  # the tries ran out before every place of the stop was tried
+    ended: SearchEnd = "work"
+    tries = max(int(effort.work_s * TRIES_PER_S), 1)
     for stop in unassigned:
-        if stop.reason != "battery" or time.perf_counter() >= deadline:
+        if stop.reason != "battery":
             continue
         node = place_of[stop.id]
         for insertion in _candidates(day, routes, node, minimize_vehicles):
-            if time.perf_counter() >= deadline:
+            if effort.out_of_time():
+                ended = "time_limit"
+            if tries <= 0 or ended == "time_limit":
+                untried.add(node)
                 break
+            tries -= 1
             v = insertion.v
             shift = day.shifts[v]
             order, charges = _with_stop(day, results.get(v), insertion)
@@ -110,17 +124,26 @@ def serve_with_charging(
                 served.add(node)
                 break
     left = [
-        replace(
-            u,
-            detail=f"{u.detail}; charging did not let a van serve it either (no "
-            "charger within reach, or no time for the charge)",
-        )
+        replace(u, detail=f"{u.detail}; {_charging_said(place_of[u.id] in untried)}")
         if u.reason == "battery"
         else u
         for u in unassigned
         if place_of[u.id] not in served
     ]
-    return routes, results, left
+    return routes, results, left, ended
+
+
+def _charging_said(untried: bool) -> str:
+    """What charging did for a stop left out for its battery."""
+    if untried:
+        return (
+            "the search for a van to serve it with charging ended before it was tried at "
+            "every place (a larger work_s tries more)"
+        )
+    return (
+        "charging did not let a van serve it either (no charger within reach, or no time "
+        "for the charge)"
+    )
 
 
 @dataclass(frozen=True)

@@ -37,6 +37,7 @@ from core.params import (
 )
 from core.physics.battery import BatteryVerdict
 from core.physics.weather import DayWeather, WeatherSource
+from core.routing.effort import Effort, SearchEnd
 from core.routing.geo import DistanceSource
 from core.routing.tsp import SolverStatus
 
@@ -46,18 +47,21 @@ DEPOT_CHARGER_ID = "depot"
 MAX_ROUND_S = 7 * 86_400.0
 #: Most vans in one fleet plan.
 MAX_VEHICLES = 100
-#: Solver budget of one round [s] when the request gives none: rounds of up to about 60 stops
-#: are proven optimal within it, larger ones come within about 0.1 % of LKH-3.
-PLAN_TIME_LIMIT_S = 1.0
-#: Solver budget of a fleet [s] when the request gives none: the split across vans and the
-#: verification by simulation take longer than one round.
-FLEET_TIME_LIMIT_S = 5.0
-#: Longest solver budget a problem may ask for [s].
+#: Longest a round's search may run [s] when the request gives no limit; its work (a tenth, a
+#: reference second) proves rounds of up to about 60 stops optimal and brings larger ones
+#: within about 0.1 % of LKH-3.
+PLAN_TIME_LIMIT_S = 10.0
+#: Longest a fleet's search may run [s] when the request gives none: the split across vans and
+#: the verification by simulation take longer than one round.
+FLEET_TIME_LIMIT_S = 50.0
+#: Longest a problem may ask its search to run, and most work it may ask for [s].
 MAX_TIME_LIMIT_S = 600.0
-
-
-#: Least solver budget [s]: less is no search at all (and 1e-300 s is not a budget).
+#: Least search time [s]: less is no search at all (and 1e-300 s is not a time).
 MIN_TIME_LIMIT_S = 0.01
+#: The search's work when the request gives none: this share of ``time_limit_s`` — on the
+#: reference machine it is done, with the simulations and the charging search around it,
+#: within a third of the limit, and within the limit with both cores busy with other solves.
+WORK_SHARE = 0.1
 
 
 def time_limit_field(default_s: float) -> float:
@@ -66,8 +70,42 @@ def time_limit_field(default_s: float) -> float:
         default_s,
         ge=MIN_TIME_LIMIT_S,
         le=MAX_TIME_LIMIT_S,
-        description="Solver budget [s], at least 0.01 s; capped by the server's setting.",
+        description="The most the search may take [s], at least 0.01 s (capped by the server's "
+        "setting): a search the limit stops says so (solver.stopped_by: time_limit) and may "
+        "answer otherwise on a retry. Its work, unless work_s is given, is a tenth of it.",
     )
+
+
+def cut_short(stopped_by: SearchEnd) -> list[str]:
+    """The warning of an answer whose search the time limit stopped before its work was done."""
+    if stopped_by != "time_limit":
+        return []
+    return [
+        "the search was stopped by its time limit (time_limit_s) before its work (work_s) was "
+        "done: on a busy or slower machine the same request may give another plan; a longer "
+        "time_limit_s, or a smaller work_s, gives the same answer every time"
+    ]
+
+
+class SearchFields(Params):
+    """How much the search does, from which seed: the same request gives the same answer."""
+
+    work_s: float | None = Field(
+        None,
+        ge=MIN_TIME_LIMIT_S,
+        le=MAX_TIME_LIMIT_S,
+        description="The search's work in reference seconds (what one core of the reference "
+        "machine does in that time; kicks, iterations and deterministic time in each solver): "
+        "the same amount of search on any machine and under any load, so the same answer. "
+        "Absent: a tenth of time_limit_s. Searches end earlier on a proof.",
+    )
+    seed: int = Field(0, ge=0, le=2**31 - 1, description="Seed of every search's randomness.")
+
+    def effort(self, time_limit_s: float) -> Effort:
+        """The search's effort from now: its work (``work_s``, or :data:`WORK_SHARE` of
+        ``time_limit_s``), capped ``time_limit_s`` from now, with the seed."""
+        work_s = self.work_s if self.work_s is not None else WORK_SHARE * time_limit_s
+        return Effort.starting_now(work_s, time_limit_s, self.seed)
 
 
 class RoundFields(Params):
@@ -242,7 +280,7 @@ class StartFields(Params):
     )
 
 
-class PlanFields(RoundFields, TripFields, StartFields):
+class PlanFields(RoundFields, TripFields, StartFields, SearchFields):
     """One round: when it leaves, and whether its order is the client's."""
 
     start_time: ClockTime = clock_field(
@@ -306,7 +344,7 @@ class FleetVehicle(ShiftFields):
     van: VanParams = Field(default_factory=VanParams, description="The van, as in a plan.")
 
 
-class FleetFields(RoundFields):
+class FleetFields(RoundFields, SearchFields):
     """A fleet's day: how the vans are chosen."""
 
     minimize_vehicles: bool = Field(
@@ -474,14 +512,22 @@ class DayProfile:
     box_temperature_c: list[float] | None
 
 
+#: The parts of a plan a proof may cover: the order of its stops.
+ProvenPart = Literal["order"]
+
+
 @dataclass(frozen=True)
 class Solved:
-    """How the order of the stops was found: the solver's status, the objective's value in its
-    unit (m, s or Wh) and the search time [s]."""
+    """How the plan was found: the solver's status (``optimal`` only when every part of it
+    is proven: the order, and no charge or reload placed by a heuristic), the objective's
+    value in its unit (m, s or Wh), the search time [s], how the searches stopped, and the
+    parts that carry a proof."""
 
     status: SolverStatus
     objective_value: float
     runtime_s: float
+    stopped_by: SearchEnd = "work"
+    proven: tuple[ProvenPart, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -563,6 +609,8 @@ class FleetResult:
     runtime_s, verification_rounds
         The whole time taken [s], and how often the fleet was verified by simulation (and
         re-solved after a failed verification).
+    stopped_by
+        How the searches stopped: their work done, or cut short by the time limit.
     timezone, distance_source, warnings
         As in a round's result.
     """
@@ -581,3 +629,4 @@ class FleetResult:
     timezone: str
     distance_source: DistanceSource
     warnings: list[str]
+    stopped_by: SearchEnd = "work"

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import datetime as dt
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +34,7 @@ from core.planning.model import (
     PlanResult,
     Solved,
     check_places,
+    cut_short,
 )
 from core.planning.recharge import visits_of, with_charges
 from core.planning.reloads import check_payload, with_reloads
@@ -45,15 +46,16 @@ from core.planning.scene import (
     round_places,
     weather_service_for,
 )
-from core.planning.start_state import check_start, path_tour, under_way
+from core.planning.start_state import START_ID, check_start, path_tour, under_way
 from core.planning.timeline import client_legs_too_fast, windows_after
+from core.routing.effort import Effort, SearchEnd, combined
 from core.routing.geo import Legs, build_legs
 from core.routing.roads import LegRoute, RememberingRouter, RoadRouter
 from core.routing.tsp import Tour, solve_path, solve_tour
 
-#: Search budget for each stretch between charges of a round [s]: stretches are short enough
-#: for CP-SAT's proof within it.
-TRIP_TIME_LIMIT_S = 0.2
+#: Search work for each stretch between charges of a round [reference s]: stretches are short
+#: enough for CP-SAT's proof within it.
+TRIP_WORK_S = 0.2
 
 
 def plan(
@@ -78,6 +80,7 @@ def plan(
         so.
     """
     started = time.perf_counter()
+    effort = problem.effort(problem.time_limit_s)
     start, timezone_name = check(problem)
     problem = under_way(problem)
     places = round_places(problem)
@@ -93,10 +96,12 @@ def plan(
     )
     windowed = any(stop.time_windows for stop in problem.stops)
     if windowed and not problem.keep_order:
-        return _in_windows(problem, scene, start, router, started)
+        return _in_windows(problem, scene, start, router, started, effort)
     cost, unit_value, offset = cost_matrix(problem, legs, start)
-    tours = _Tours(cost, len(places) - len(problem.chargers), problem.start_state is not None)
-    tour = tours.first(problem.time_limit_s, problem.keep_order)
+    tours = _Tours(
+        cost, len(places) - len(problem.chargers), problem.start_state is not None, effort
+    )
+    tour = tours.first(problem.keep_order)
     order = with_reloads(problem, tour.order, None if problem.keep_order else tours.stretch)
     round_s = float(legs.duration_s[order[:-1], order[1:]].sum()) + sum(
         stop.service_time_s for stop in problem.stops
@@ -125,6 +130,9 @@ def plan(
         windows_after(problem.stops, problem.date, start) if windowed else None,
         None if problem.keep_order else tours,
     )
+    solved = _how_solved(tour, result, scene.places, tours.ends)
+    warnings = [*result.warnings, *cut_short(solved.stopped_by)]
+    result = replace(result, solved=solved, warnings=warnings)
     if result.late_stops:  # the client's own order misses a window
         late = result.late_stops[0]
         index = next(k for k, stop in enumerate(problem.stops) if stop.id == late)
@@ -138,25 +146,57 @@ def plan(
     return result
 
 
+def _how_solved(
+    tour: Tour, result: PlanResult, places: list[Place], ends: list[SearchEnd]
+) -> Solved:
+    """The plan's status: ``optimal`` only when its whole answer carries the proof — the
+    order of the stops proven and kept, and no charge or reload placed by the heuristics
+    after it (then ``feasible``, with ``order`` in ``proven`` while the stops keep the proven
+    order); how its searches stopped."""
+    proven_ids = [places[k].id for k in tour.order[1:-1]]
+    kept = tour.status == "optimal" and [s.id for s in result.stops] == [
+        i for i in proven_ids if i != START_ID
+    ]
+    whole = kept and not (result.charges or result.reloads)
+    status = tour.status if tour.status != "optimal" else ("optimal" if whole else "feasible")
+    return replace(
+        result.solved,
+        status=status,
+        stopped_by=combined(ends),
+        proven=("order",) if kept else (),
+    )
+
+
 @dataclass(frozen=True)
 class _Tours:
     """The round's orders on the solver's ``cost`` (every place: the depot, the stops, the
     van's position when under way, then the chargers): the places up to ``visited`` are the
-    round's, the chargers after them are visited as the battery needs."""
+    round's, the chargers after them are visited as the battery needs. Every search shares
+    ``effort``'s deadline and seed; ``ends`` collects how each stopped."""
 
     cost: NDArray[np.int64]
     visited: int
     under_way: bool
+    effort: Effort
+    ends: list[SearchEnd] = field(default_factory=list)
 
-    def first(self, time_limit_s: float, keep_order: bool) -> Tour:
+    def ended(self, tour: Tour) -> Tour:
+        self.ends.append(tour.ended)
+        return tour
+
+    def first(self, keep_order: bool) -> Tour:
         """The round without charging: a round trip, or from the van's position to the depot."""
         cost = self.cost[: self.visited, : self.visited]
         if self.under_way:
-            return path_tour(cost, time_limit_s, keep_order)
-        return solve_tour(cost, time_limit_s, keep_order)
+            return self.ended(path_tour(cost, self.effort, keep_order))
+        return self.ended(solve_tour(cost, self.effort, keep_order))
 
     def stretch(self, places: list[int]) -> list[int]:
-        return solve_path(self.cost, places, TRIP_TIME_LIMIT_S).order
+        return self.ended(solve_path(self.cost, places, self._trip())).order
+
+    def _trip(self, trips: int = 1) -> Effort:
+        """A stretch's work: :data:`TRIP_WORK_S` each, under the round's deadline."""
+        return replace(self.effort, work_s=TRIP_WORK_S * trips)
 
     def through(self, chargers: list[int]) -> list[int]:
         """The round again with a visit to each of ``chargers`` (a place listed twice, twice),
@@ -170,9 +210,9 @@ class _Tours:
         if self.under_way:
             start = self.visited - 1
             ends = [start, *range(1, start), *range(self.visited, len(nodes)), 0]
-            path = solve_path(cost, ends, TRIP_TIME_LIMIT_S * len(chargers)).order
+            path = self.ended(solve_path(cost, ends, self._trip(len(chargers)))).order
         else:
-            path = solve_tour(cost, TRIP_TIME_LIMIT_S * len(chargers)).order
+            path = self.ended(solve_tour(cost, self._trip(len(chargers)))).order
         return [nodes[k] for k in path]
 
 
@@ -182,6 +222,7 @@ def _in_windows(
     start: dt.datetime,
     router: RoadRouter | None,
     started: float,
+    effort: Effort,
 ) -> PlanResult:
     """The round when stops have time windows: the fleet search with this one van, its
     battery reported, not a constraint, and every stop required; a stop no order serves in
@@ -192,7 +233,7 @@ def _in_windows(
     van = VanShift("van", problem, start, None, battery_enforced=False)
     under_way = [len(problem.stops) + 1] if problem.start_state is not None else None
     day = fleet_day([van], scene, remembering, under_way)
-    routed = search(day, minimize_vehicles=False, deadline=started + problem.time_limit_s)
+    routed = search(day, False, effort)
     if routed.unassigned:
         first = routed.unassigned[0]
         index = next(k for k, stop in enumerate(problem.stops) if stop.id == first.id)
@@ -207,7 +248,10 @@ def _in_windows(
         charged = day.charged(0, order, {}, {})
         if charged.battery.margin_kwh > result.battery.margin_kwh:
             result = replace(charged, solved=result.solved)
-    return replace(result, solved=replace(result.solved, runtime_s=time.perf_counter() - started))
+    solved = replace(
+        result.solved, runtime_s=time.perf_counter() - started, stopped_by=routed.ended
+    )
+    return replace(result, solved=solved, warnings=[*result.warnings, *cut_short(routed.ended)])
 
 
 def _check_reachable(problem: PlanProblem, places: list[Place], legs: Legs) -> None:

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 from core.exceptions import InvalidParameterError
 from core.params import MIN_SOC_WINDOW
 from core.planning.model import PlanProblem, RoundFields
+from core.routing.effort import Effort
 from core.routing.tsp import Tour, solve_path
 
 #: The id of the van's position in the tour and the legs.
@@ -113,9 +114,9 @@ def box_start_c(problem: PlanProblem) -> float | None:
     return state.box_temperature_c
 
 
-def path_tour(cost: NDArray[np.int64], time_limit_s: float, keep_order: bool) -> Tour:
+def path_tour(cost: NDArray[np.int64], effort: Effort, keep_order: bool) -> Tour:
     """The shortest path from the last place of ``cost`` (the van's position) through the
     stops to place 0 (the depot), as a tour of the places' indices from the start to the
     depot; its cost and status are the path's."""
     n = cost.shape[0]
-    return solve_path(cost, [n - 1, *range(1, n - 1), 0], time_limit_s, keep_order)
+    return solve_path(cost, [n - 1, *range(1, n - 1), 0], effort, keep_order)

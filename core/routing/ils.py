@@ -36,10 +36,10 @@ NEIGHBOURS = 10
 SEGMENT_MAX = 3
 #: Longest segment a kick swaps [places].
 KICK_SEGMENT_MAX = 50
-#: Kicks in the first call of the compiled search; later calls take as many as fit in
-#: :data:`CALL_S`, so the search looks at the clock that often.
-FIRST_KICKS = 50
-CALL_S = 0.02
+#: Kicks in each call of the compiled search: the clock (the deadline) is looked at between
+#: calls, and each call's seed follows from the ones before, so the calls are the same however
+#: fast they run.
+CALL_KICKS = 100
 
 
 def neighbours(cost: IntArray, count: int = NEIGHBOURS) -> IntArray:
@@ -66,27 +66,34 @@ def neighbours(cost: IntArray, count: int = NEIGHBOURS) -> IntArray:
 
 
 def iterated_local_search(
-    cost: IntArray, order: list[int], deadline: float, seed: int = 0, stall_kicks: int = 0
-) -> list[int]:
-    """The best tour from ``order`` (depot first and last) by ``deadline`` (a
-    ``time.perf_counter`` value), or once ``stall_kicks`` kicks in a row brought nothing
-    (0: only the deadline); seeded, so the same when it stalls before the deadline."""
+    cost: IntArray,
+    order: list[int],
+    kicks: int,
+    deadline: float,
+    seed: int = 0,
+    stall_kicks: int = 0,
+) -> tuple[list[int], bool]:
+    """The best tour from ``order`` (depot first and last) after ``kicks`` kicks, or once
+    ``stall_kicks`` kicks in a row brought nothing (0: no such stop), or at ``deadline`` (a
+    ``time.perf_counter`` value) if that comes first; and whether the deadline stopped it.
+    Seeded and in calls of :data:`CALL_KICKS`: the same answer whenever the deadline does
+    not stop it."""
     n = cost.shape[0]
     if n < 5:
-        return order
+        return order, False
     near = neighbours(cost)
     tour = np.asarray(order[:-1], dtype=np.int64)
     tour = _local_search_all(cost, tour, near)
-    stalled, call, kicks = 0, 0, FIRST_KICKS
-    while (now := time.perf_counter()) < deadline and not (stall_kicks and stalled >= stall_kicks):
-        tour, improved = _kicks(cost, tour, near, kicks, seed + call)
-        stalled = 0 if improved else stalled + kicks
+    stalled, call, done = 0, 0, 0
+    while done < kicks and not (stall_kicks and stalled >= stall_kicks):
+        if time.perf_counter() >= deadline:
+            return [*(int(x) for x in tour), 0], True
+        batch = min(CALL_KICKS, kicks - done)
+        tour, improved = _kicks(cost, tour, near, batch, seed + call)
+        stalled = 0 if improved else stalled + batch
+        done += batch
         call += 1
-        # As many kicks in the next call as fit in CALL_S at this call's pace.
-        per_kick_s = max(time.perf_counter() - now, 1e-6) / kicks
-        left_s = deadline - time.perf_counter()
-        kicks = max(1, int(min(CALL_S, left_s) / per_kick_s))
-    return [*(int(x) for x in tour), 0]
+    return [*(int(x) for x in tour), 0], False
 
 
 @njit(cache=True)

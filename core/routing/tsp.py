@@ -5,8 +5,8 @@ rounds, ``benchmarks/bench_planner.py``):
 
 1. An iterated local search (:mod:`core.routing.ils`: 2-opt and Or-opt on near places and
    the spanning tree's links, double-bridge kicks), :data:`RUNS` runs from Christofides' tour
-   with their own seeds, the best kept. Each run ends at its share of the budget or after
-   :data:`STALL_KICKS` kicks without improvement.
+   with their own seeds, the best kept. Each run ends after its share of the work's kicks or
+   after :data:`STALL_KICKS` kicks without improvement.
 2. CP-SAT's circuit constraint with its LP relaxation (linearization level 2) and the 2-cycle
    cuts ``x_ij + x_ji ≤ 1``, which the circuit's LP lacks and which make it much tighter, on
    every arc: from the local search's tour it proves the optimum of rounds up to
@@ -15,8 +15,9 @@ rounds, ``benchmarks/bench_planner.py``):
    ``optimal`` status; a model on fewer arcs (each place's nearest, say) proves nothing, for on
    clustered rounds the arcs between clusters that the best tour takes are seldom among them.
 
-Every search is single-threaded and seeded, so a busy second core does not change the answer
-when the search ends before its limit, and the time limit is a deadline: nothing runs past it.
+Every search is single-threaded, seeded and stopped by its work (:mod:`core.routing.effort`:
+kicks, CP-SAT's deterministic time), so a busy machine does not change the answer; the deadline
+only caps it, and the tour says when it did (``ended``).
 Costs are non-negative integers: the caller rounds explicitly (metres, seconds, Wh).
 """
 
@@ -33,18 +34,20 @@ from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 from ortools.sat.python import cp_model
 
 from core.exceptions import InvalidParameterError
+from core.routing.effort import Effort, SearchEnd, combined
 
 SolverStatus = Literal["optimal", "feasible", "fixed_order"]
 #: Rounds up to this many nodes (depot included) are proven on the full graph from
-#: Christofides' tour with the whole budget: tens of milliseconds.
+#: Christofides' tour: tens of milliseconds.
 FULL_GRAPH_MAX_NODES = 30
-#: Up to this many, the full graph has what the local search leaves of the budget: a proof in
-#: a few hundred milliseconds on most delivery rounds.
+#: Up to this many, the full graph after a first local search: a proof in a few hundred
+#: milliseconds on most delivery rounds.
 PROOF_MAX_NODES = 60
-#: Share of the budget the local search has before a proof is tried, and the share by which
-#: the proof must end (the local search has the rest).
+#: Share of the work the local search has before a proof is tried (beyond
+#: :data:`FULL_GRAPH_MAX_NODES`), and the share the two have together; the local search has
+#: the rest when no proof comes.
 PROOF_SEARCH_SHARE = 0.3
-PROOF_SHARE_END = 0.8
+PROOF_SHARE = 0.8
 #: Independent runs of the local search sharing its budget.
 RUNS = 3
 #: Kicks without improvement after which a run of the local search ends early.
@@ -65,12 +68,15 @@ class Tour:
         Sum of the integer arc costs along the tour.
     runtime_s
         Wall-clock time of the search [s].
+    ended
+        How the search stopped: its optimum proven, its work done, or at the deadline.
     """
 
     order: list[int]
     status: SolverStatus
     cost: int
     runtime_s: float
+    ended: SearchEnd = "work"
 
 
 def tour_cost(cost: NDArray[np.int64], order: list[int]) -> int:
@@ -78,59 +84,58 @@ def tour_cost(cost: NDArray[np.int64], order: list[int]) -> int:
     return int(cost[order[:-1], order[1:]].sum())
 
 
-def solve_tour(
-    cost: NDArray[np.int64], time_limit_s: float = 1.0, keep_order: bool = False
-) -> Tour:
+def solve_tour(cost: NDArray[np.int64], effort: Effort, keep_order: bool = False) -> Tour:
     """Shortest round trip from node 0 through every other node and back.
 
     Parameters
     ----------
     cost
         Square matrix of non-negative integer arc costs; may be asymmetric.
-    time_limit_s
-        Wall-clock budget of the search [s], > 0.
+    effort
+        The search's work, its deadline and its seed.
     keep_order
         Evaluate the order 0, 1, …, n−1, 0 as given instead of optimising.
 
     Returns
     -------
     Tour
-        Deterministic for the same input when the search ends before the time limit.
+        The same for the same input and effort, unless the deadline stopped it (``ended``).
     """
     cost = np.asarray(cost, dtype=np.int64)
     n = cost.shape[0]
     if cost.ndim != 2 or cost.shape != (n, n) or n < 1 or (cost < 0).any():
         raise InvalidParameterError("cost must be a square matrix of non-negative integers", "cost")
-    if not time_limit_s > 0:
-        raise InvalidParameterError(f"time_limit_s must be > 0, got {time_limit_s}", "time_limit_s")
     started = time.perf_counter()
-    deadline = started + time_limit_s
 
-    def done(order: list[int], status: SolverStatus) -> Tour:
-        return Tour(order, status, tour_cost(cost, order), time.perf_counter() - started)
+    def done(order: list[int], status: SolverStatus, *ends: SearchEnd) -> Tour:
+        elapsed = time.perf_counter() - started
+        return Tour(order, status, tour_cost(cost, order), elapsed, combined(ends))
 
     if keep_order or n <= 3:
         order = [*range(n), 0]
         if n == 3 and not keep_order:
             order = min(([0, 1, 2, 0], [0, 2, 1, 0]), key=lambda o: tour_cost(cost, o))
-        return done(order, "fixed_order" if keep_order else "optimal")
+        return done(
+            order, "fixed_order" if keep_order else "optimal", "work" if keep_order else "proof"
+        )
     start = _first_tour(cost)
     if n > PROOF_MAX_NODES:
-        return done(_improve(cost, start, deadline), "feasible")
-    best, proof_deadline = start, deadline
-    if n > FULL_GRAPH_MAX_NODES:
-        best = _improve(cost, start, started + time_limit_s * PROOF_SEARCH_SHARE)
-        proof_deadline = started + time_limit_s * PROOF_SHARE_END
-    found, proven = _solve_exact(cost, best, proof_deadline)
+        best, cut = _improve(cost, start, effort)
+        return done(best, "feasible", "time_limit" if cut else "work")
+    search_share = PROOF_SEARCH_SHARE if n > FULL_GRAPH_MAX_NODES else 0.0
+    best, cut = _improve(cost, start, effort.share(search_share))
+    found, proven, exact_cut = _solve_exact(cost, best, effort.share(PROOF_SHARE - search_share))
     if found is not None and tour_cost(cost, found) <= tour_cost(cost, best):
         best = found
     if proven:
-        return done(best, "optimal")
-    return done(_improve(cost, best, deadline), "feasible")
+        return done(best, "optimal", "proof")
+    best, last_cut = _improve(cost, best, effort.share(1 - PROOF_SHARE))
+    cut_short: list[SearchEnd] = ["time_limit"] if cut or exact_cut or last_cut else []
+    return done(best, "feasible", *cut_short, "work")
 
 
 def solve_path(
-    cost: NDArray[np.int64], nodes: list[int], time_limit_s: float = 1.0, keep_order: bool = False
+    cost: NDArray[np.int64], nodes: list[int], effort: Effort, keep_order: bool = False
 ) -> Tour:
     """The cheapest path through ``nodes`` of ``cost`` from the first to the last, as node
     indices from first to last (the same node first and last: a round trip); its cost and
@@ -139,7 +144,7 @@ def solve_path(
     first, last = nodes[0], nodes[-1]
     if first == last:
         inner = nodes[:-1]
-        tour = solve_tour(cost[np.ix_(inner, inner)], time_limit_s, keep_order)
+        tour = solve_tour(cost[np.ix_(inner, inner)], effort, keep_order)
         return replace(tour, order=[inner[k] for k in tour.order])
     path = cost[np.ix_(nodes, nodes)].copy()
     end = len(nodes) - 1
@@ -147,7 +152,7 @@ def solve_path(
     path[end, :] = never
     path[:, 0] = never
     path[end, 0] = 0
-    tour = solve_tour(path, time_limit_s, keep_order)
+    tour = solve_tour(path, effort, keep_order)
     return replace(tour, order=[nodes[k] for k in tour.order[:-1]])
 
 
@@ -159,22 +164,22 @@ def prepare() -> None:
     ils.warm_up()
 
 
-def _improve(cost: NDArray[np.int64], start: list[int], deadline: float) -> list[int]:
-    """The best of :data:`RUNS` local searches from ``start``, sharing the time to
-    ``deadline`` (a ``time.perf_counter`` value); ``start`` if no time is left."""
+def _improve(cost: NDArray[np.int64], start: list[int], effort: Effort) -> tuple[list[int], bool]:
+    """The best of :data:`RUNS` local searches from ``start``, sharing the effort's kicks
+    (each with its own seed); and whether the deadline cut them short."""
     from core.routing.ils import iterated_local_search
 
     best = start
+    kicks = effort.kicks(cost.shape[0]) // RUNS
     for run in range(RUNS):
-        remaining = deadline - time.perf_counter()
-        if remaining <= 0:
-            break
-        found = iterated_local_search(
-            cost, start, time.perf_counter() + remaining / (RUNS - run), 1000 * run, STALL_KICKS
+        found, cut = iterated_local_search(
+            cost, start, kicks, effort.deadline, effort.seed + 1000 * run, STALL_KICKS
         )
         if tour_cost(cost, found) < tour_cost(cost, best):
             best = found
-    return best
+        if cut:
+            return best, True
+    return best, False
 
 
 #: Time kept back from CP-SAT's budget for its own stopping and for reading the solution, a
@@ -186,13 +191,13 @@ _EXACT_STOP_MARGIN_PER_ARC_S = 2.5e-6
 def _solve_exact(
     cost: NDArray[np.int64],
     start: list[int],
-    deadline: float,
+    effort: Effort,
     keep: NDArray[np.bool_] | None = None,
-) -> tuple[list[int] | None, bool]:
+) -> tuple[list[int] | None, bool, bool]:
     """CP-SAT with a circuit constraint, its LP relaxation and 2-cycle cuts, from ``start``,
-    to finish by ``deadline`` (a ``time.perf_counter`` value); one worker, so the search is
-    deterministic. The best tour found (or None) and whether it is proven optimal over the
-    model's arcs: every arc, or those of ``keep`` and of ``start``."""
+    for the effort's deterministic time (one worker, seeded: deterministic), by its deadline.
+    The best tour found (or None), whether it is proven optimal over the model's arcs (every
+    arc, or those of ``keep`` and of ``start``), and whether the deadline stopped it."""
     n = cost.shape[0]
     keep = np.ones((n, n), dtype=bool) if keep is None else keep.copy()
     keep[start[:-1], start[1:]] = True
@@ -216,20 +221,25 @@ def _solve_exact(
     solver.parameters.linearization_level = 2
     solver.parameters.cp_model_presolve = False
     margin_s = _EXACT_STOP_MARGIN_S + _EXACT_STOP_MARGIN_PER_ARC_S * len(arcs)
-    budget_s = deadline - time.perf_counter() - margin_s
+    budget_s = effort.left_s() - margin_s
     if budget_s <= 0:
-        return None, False
-    solver.parameters.max_time_in_seconds = budget_s
+        return None, False, True
+    work = effort.cpsat_deterministic_time()
+    if work <= 0:
+        return None, False, False
+    solver.parameters.max_time_in_seconds = min(budget_s, 86_400.0)  # "never" is no number
+    solver.parameters.max_deterministic_time = work
     solver.parameters.num_workers = 1
-    solver.parameters.random_seed = 0
+    solver.parameters.random_seed = effort.seed
     result = solver.solve(model)
+    cut = result != cp_model.OPTIMAL and solver.deterministic_time < work * 0.999
     if result not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
-        return None, False
+        return None, False, cut
     successor = {i: j for (i, j), var in arcs.items() if solver.boolean_value(var)}
     order = [0]
     while len(order) <= n:
         order.append(successor[order[-1]])
-    return order, result == cp_model.OPTIMAL
+    return order, result == cp_model.OPTIMAL, cut
 
 
 def _routing(cost: NDArray[np.int64]) -> tuple[pywrapcp.RoutingIndexManager, pywrapcp.RoutingModel]:

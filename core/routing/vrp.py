@@ -10,38 +10,39 @@ Two engines, each where it is strongest (``benchmarks/bench_fleet.py``):
 
 1. PyVRP's iterated local search (Wouda, Lan & Kool 2024) on windows, shifts and payload: on
    Solomon's instances within a fraction of a percent of the best known routes. A stop with
-   several windows is a group of alternatives, one per window. It ends at the time limit or
-   after :data:`ITERATIONS_PER_STOP` iterations per stop without improvement, whichever
-   comes first (seeded: the same routes for the same input when it ends early).
+   several windows is a group of alternatives, one per window. It ends after its work's
+   iterations (:mod:`core.routing.effort`) or :data:`ITERATIONS_PER_STOP` iterations per stop
+   without improvement, whichever comes first — seeded, so the same routes for the same input
+   and effort — or, cut short, at the deadline.
 2. OR-Tools' routing library with every constraint as a dimension, the energy budget
    included, and the cost of waiting for a window: it takes over PyVRP's routes when they
    break an energy budget (less the stops that do not fit) or when waiting has a cost,
-   for the rest of the budget.
+   for its work's solutions (single-threaded: deterministic).
 """
 
 from __future__ import annotations
 
 import itertools
+import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pyvrp
 from numpy.typing import NDArray
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
-from pyvrp.stop import MaxRuntime, MultipleCriteria, NoImprovement
+
+from core.routing.effort import Effort, SearchEnd, combined
 
 IntMatrix = NDArray[np.int64]
 
-#: Iterations per stop without an improvement after which PyVRP ends before its time limit.
+#: Iterations per stop without an improvement after which PyVRP ends before its work is done.
 ITERATIONS_PER_STOP = 200
-#: Solutions per stop after which guided local search ends before its time limit.
-SOLUTIONS_PER_STOP = 40
-#: Share of the budget OR-Tools has to price the waits of PyVRP's routes.
-WAIT_POLISH_SHARE = 0.2
 #: The searches overshoot their limit by a few milliseconds; they get this much less [s].
 _STOP_MARGIN_S = 0.01
+#: Longest cap OR-Tools is given [s] (a day): a deadline that never comes is no number it takes.
+MAX_CAP_S = 86_400.0
 
 
 @dataclass(frozen=True)
@@ -123,45 +124,48 @@ class RoutingInput:
 @dataclass(frozen=True)
 class RoutingOutcome:
     """Stops of each van in driving order (no depot around them; a 0 between stops is a
-    return to reload); a stop in no route is left out."""
+    return to reload); a stop in no route is left out. ``ended``: how the search stopped."""
 
     routes: list[list[int]]
+    ended: SearchEnd = "work"
 
 
 def solve_routes(
-    problem: RoutingInput, time_limit_s: float, initial: list[list[int]] | None = None
+    problem: RoutingInput, effort: Effort, initial: list[list[int]] | None = None
 ) -> RoutingOutcome | None:
-    """Routes for every van; None when the search finds no solution within the limit.
+    """Routes for every van; None when the search finds no solution.
 
     Parameters
     ----------
     problem
         Places and vans.
-    time_limit_s
-        Search budget [s]; a deadline.
+    effort
+        The search's work (PyVRP's iterations, OR-Tools' solutions), deadline and seed: the
+        same routes for the same effort unless the deadline stops the search (``ended``).
     initial
         Routes to start from (stops per van); ignored when they break a constraint.
     """
-    deadline = time.perf_counter() + time_limit_s
     # OR-Tools' model has no reloads: routes that reload are PyVRP's, trimmed to the budget.
     reloads = any(v.max_reloads for v in problem.vehicles)
     waits_cost = any(v.wait_cost_per_s for v in problem.vehicles) and not reloads
-    share = WAIT_POLISH_SHARE if waits_cost else 0.0
-    found = _pyvrp_routes(problem, deadline - time_limit_s * share, initial)
+    found, ended = _pyvrp_routes(problem, effort, initial)
     if found is not None and not waits_cost and not _over_energy(problem, found):
-        return RoutingOutcome(found)
+        return RoutingOutcome(found, ended)
     if found is None:
         one_trip = None if initial is None else [[n for n in r if n] for r in initial]
-        return _ortools_routes(problem, deadline, one_trip)
+        polished = _ortools_routes(problem, effort, one_trip)
+        return (
+            None if polished is None else replace(polished, ended=combined([ended, polished.ended]))
+        )
     fitting = [_within_energy(problem, v, r) for v, r in enumerate(found)]
     if reloads:
-        return RoutingOutcome(fitting)
-    polished = _ortools_routes(problem, deadline, fitting)
-    # OR-Tools may find less in what is left of the budget (or reject the start and begin
-    # afresh): PyVRP's routes, trimmed, hold.
+        return RoutingOutcome(fitting, ended)
+    polished = _ortools_routes(problem, effort, fitting)
+    # OR-Tools may find less (or reject the start and begin afresh): PyVRP's routes,
+    # trimmed, hold.
     if polished is None or _served(polished.routes) < _served(fitting):
-        return RoutingOutcome(fitting)
-    return polished
+        return RoutingOutcome(fitting, ended)
+    return replace(polished, ended=combined([ended, polished.ended]))
 
 
 def _served(routes: list[list[int]]) -> int:
@@ -339,24 +343,51 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
     return _PyvrpModel(data, client_node, node_clients, list(kinds.values()))
 
 
+class _Stop:
+    """PyVRP's stopping criterion: its iterations (the work), no improvement in ``patience``
+    iterations, or the deadline — and which of them stopped it."""
+
+    def __init__(self, iterations: int, patience: int, deadline: float) -> None:
+        self.left, self.patience, self.deadline = iterations, patience, deadline
+        self.best, self.idle = math.inf, 0
+        self.ended: SearchEnd = "work"
+
+    def __call__(self, best_cost: float) -> bool:
+        if best_cost < self.best:
+            self.best, self.idle = best_cost, 0
+        else:
+            self.idle += 1
+        self.left -= 1
+        if time.perf_counter() >= self.deadline:
+            self.ended = "time_limit"
+            return True
+        return self.left < 0 or self.idle > self.patience
+
+
 def _pyvrp_routes(
-    problem: RoutingInput, deadline: float, initial: list[list[int]] | None
-) -> list[list[int]] | None:
-    """PyVRP's best feasible routes per van by ``deadline``; None when it has none."""
+    problem: RoutingInput, effort: Effort, initial: list[list[int]] | None
+) -> tuple[list[list[int]] | None, SearchEnd]:
+    """PyVRP's best feasible routes per van after the effort's iterations (or
+    :data:`ITERATIONS_PER_STOP` per stop without improvement); None when it has none; and how
+    it stopped."""
     model = _pyvrp_model(problem)
     if not model.client_node:
-        return [[] for _ in problem.vehicles]
-    budget_s = deadline - time.perf_counter() - _STOP_MARGIN_S
-    if budget_s <= 0:
-        return None
+        return [[] for _ in problem.vehicles], "work"
+    if effort.out_of_time():
+        return None, "time_limit"
     patience = ITERATIONS_PER_STOP * len(model.node_clients)
-    stop = MultipleCriteria([MaxRuntime(budget_s), NoImprovement(patience)])
+    stop = _Stop(effort.pyvrp_iterations(len(model.client_node)), patience, effort.deadline)
     start = _pyvrp_start(model, initial)
     result = pyvrp.solve(
-        model.data, stop=stop, seed=0, display=False, collect_stats=False, initial_solution=start
+        model.data,
+        stop=stop,
+        seed=effort.seed,
+        display=False,
+        collect_stats=False,
+        initial_solution=start,
     )
     if not result.is_feasible():
-        return None
+        return None, stop.ended
     routes: list[list[int]] = [[] for _ in problem.vehicles]
     taken = [0] * len(model.type_vans)
     for route in result.best.routes():
@@ -365,7 +396,7 @@ def _pyvrp_routes(
         taken[kind] += 1
         visits = route.schedule()[1:-1]
         routes[van] = [model.client_node[a.idx] if a.is_client() else 0 for a in visits]
-    return routes
+    return routes, stop.ended
 
 
 def _pyvrp_start(model: _PyvrpModel, initial: list[list[int]] | None) -> pyvrp.Solution | None:
@@ -391,18 +422,22 @@ def _pyvrp_start(model: _PyvrpModel, initial: list[list[int]] | None) -> pyvrp.S
 
 
 def _ortools_routes(
-    problem: RoutingInput, deadline: float, initial: list[list[int]] | None
+    problem: RoutingInput, effort: Effort, initial: list[list[int]] | None
 ) -> RoutingOutcome | None:
-    """OR-Tools' guided local search with every dimension, from ``initial`` when it holds."""
+    """OR-Tools' guided local search with every dimension, from ``initial`` when it holds; its
+    work the effort's solutions (single-threaded: deterministic), the effort's deadline the
+    cap."""
     manager, routing = _model(problem)
     params = pywrapcp.DefaultRoutingSearchParameters()
     params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.PATH_CHEAPEST_ARC
     params.local_search_metaheuristic = (
         routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
     )
-    params.solution_limit = SOLUTIONS_PER_STOP * max(problem.travel_s.shape[0] - 1, 1)
-    budget_s = deadline - time.perf_counter() - _STOP_MARGIN_S
-    params.time_limit.FromMilliseconds(max(int(budget_s * 1000), 1))
+    params.solution_limit = effort.ortools_solutions(problem.travel_s.shape[0])
+    budget_s = effort.left_s() - _STOP_MARGIN_S
+    if budget_s <= 0:
+        return None
+    params.time_limit.FromMilliseconds(max(int(min(budget_s, MAX_CAP_S) * 1000), 1))
     routing.CloseModelWithParameters(params)
     solution = None
     if initial is not None:
@@ -413,6 +448,7 @@ def _ortools_routes(
             solution = routing.SolveFromAssignmentWithParameters(start, params)
     if solution is None:
         solution = routing.SolveWithParameters(params)
+    ended: SearchEnd = "time_limit" if effort.out_of_time() else "work"
     if solution is None:
         return None
     routes: list[list[int]] = []
@@ -423,7 +459,7 @@ def _ortools_routes(
             route.append(manager.IndexToNode(index))
             index = solution.Value(routing.NextVar(index))
         routes.append(route)
-    return RoutingOutcome(routes)
+    return RoutingOutcome(routes, ended)
 
 
 def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapcp.RoutingModel]:

@@ -18,10 +18,11 @@ import psycopg
 import pytest
 import redis
 
-from app.examples import PLAN_EXAMPLE
+from app.examples import CHARGING_PLAN_EXAMPLE, PLAN_EXAMPLE
 from benchmarks.common import Server
 from tests.app.serving import children, cpu_ticks, long_plan
 from tests.app.test_jobs import assert_spaced, submit, wait_for
+from tests.app.test_reproducible import without_timing
 from tests.router_stub import DownRouter
 
 POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
@@ -139,6 +140,16 @@ def test_jobs_run_on_the_celery_workers(server, workers):
     assert [job["status"] for job in done] == ["succeeded"] * 4
     direct = httpx.post(f"{server.url}/v1/plans", json=PLAN_EXAMPLE, timeout=30).json()
     assert done[0]["result"]["tour"] == direct["tour"]
+
+
+def test_a_celery_job_answers_byte_for_byte_what_the_endpoint_answers(server, workers):
+    """The same request, the same answer on a Celery worker (but the timing fields): a day
+    that charges, where a search stopped by the clock would differ."""
+    job = submit(server.url, {"type": "plan", "request": CHARGING_PLAN_EXAMPLE}).json()
+    done = wait_for(server.url, job["id"], timeout=120)
+    direct = httpx.post(f"{server.url}/v1/plans", json=CHARGING_PLAN_EXAMPLE, timeout=60).json()
+    assert done["status"] == "succeeded"
+    assert without_timing(done["result"]) == without_timing(direct)
 
 
 def test_a_worker_killed_mid_job_leaves_it_to_another(server, workers):

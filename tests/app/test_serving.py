@@ -70,9 +70,9 @@ def test_liveness_answers_while_every_worker_solves(server):
 def test_a_full_queue_and_a_long_wait_are_503_with_retry_after(server):
     with concurrent.futures.ThreadPoolExecutor(3) as pool:
         busy = pool.submit(post, server.url, long_plan(300, 5))
-        time.sleep(1.0)
+        wait_until(server.url, "1 busy")
         queued = pool.submit(post, server.url, long_plan(8, 0.1))
-        time.sleep(0.3)
+        wait_until(server.url, "1 waiting")
         started = time.perf_counter()
         full = post(server.url, long_plan(8, 0.1))
         assert time.perf_counter() - started < 1.0  # refused at once, not left hanging

@@ -22,7 +22,7 @@ from tests.core.planning.test_recharge import summer_day
 FAST = Charger(id="hpc-prater", lat=48.215, lon=16.40, power_kw=150, price_per_kwh=0.59)
 
 
-def fleet(problem, vans, time_limit_s=8.0, **fields) -> FleetProblem:
+def fleet(problem, vans, time_limit_s=16.0, **fields) -> FleetProblem:
     return FleetProblem(
         **fields_of(problem, RoundFields) | fields,
         vehicles=[
@@ -36,8 +36,8 @@ def fleet(problem, vans, time_limit_s=8.0, **fields) -> FleetProblem:
 @pytest.fixture(scope="module")
 def one_van():
     day = summer_day(None)
-    # 40 % of the budget serves the stops left out with charging: 6 s on a loaded machine
-    charged = fleet(day, [day.van], chargers=[FAST], time_limit_s=15)
+    # the default work (5 s) tries the stops left out with charging 50 times
+    charged = fleet(day, [day.van], chargers=[FAST], time_limit_s=50)
     return plan_fleet(fleet(day, [day.van])), plan_fleet(charged)
 
 
@@ -80,7 +80,7 @@ def two_clusters() -> FleetProblem:
     van = day.van.model_copy(update={"battery": BatteryParams(usable_capacity_kwh=10.0)})
     depot = Depot(id="depot", lat=48.21, lon=16.37, charger=ChargePoint(power_kw=22, points=1))
     base = day.model_copy(update={"stops": stops, "depot": depot})
-    return fleet(base, [van, van], time_limit_s=12, minimize_vehicles=False)
+    return fleet(base, [van, van], time_limit_s=50, minimize_vehicles=False)
 
 
 def test_vans_at_a_one_point_charger_never_charge_at_once():

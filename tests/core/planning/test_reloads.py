@@ -107,9 +107,7 @@ def fleet_of_trips(max_trips: int, charger=None, capacity_kwh: float = 40.0) -> 
         reload_minutes=20,
         van=van,
     )
-    return FleetProblem(
-        **fields_of(day, RoundFields) | {"stops": stops}, vehicles=[vehicle], time_limit_s=8.0
-    )
+    return FleetProblem(**fields_of(day, RoundFields) | {"stops": stops}, vehicles=[vehicle])
 
 
 def trip_loads(result) -> list[float]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from core.routing.effort import Effort
 from core.routing.units import (
     energy_units_down,
     energy_units_up,
@@ -12,6 +13,9 @@ from core.routing.units import (
     payload_units_up,
 )
 from core.routing.vrp import RoutingInput, VehicleSpec, solve_routes
+
+#: A second of search work, the deadline far enough not to stop it.
+WORK = Effort(1.0, float("inf"))
 
 
 def line(positions: list[int]) -> np.ndarray:
@@ -57,7 +61,7 @@ def cost(routes: list[list[int]], positions: list[int]) -> int:
 
 def test_one_van_drives_out_and_back():
     positions = [3, 1, 4, 2]
-    outcome = solve_routes(problem(positions), 1.0)
+    outcome = solve_routes(problem(positions), WORK)
     assert outcome is not None
     # Out to 4 km and back: 8 km whatever the order, but only the sorted order does it.
     assert cost(outcome.routes, positions) == 8
@@ -66,7 +70,7 @@ def test_one_van_drives_out_and_back():
 def test_payload_splits_the_stops_between_two_vans():
     # Two stops at 1 km, two at 5 km; 2 kg each, 4 kg per van: each van takes a pair.
     positions = [1, 1, 5, 5]
-    outcome = solve_routes(problem(positions, vans=2, demand=[2000] * 4, payload=4000), 1.0)
+    outcome = solve_routes(problem(positions, vans=2, demand=[2000] * 4, payload=4000), WORK)
     assert outcome is not None
     assert sorted(sorted(r) for r in outcome.routes) == [[1, 2], [3, 4]]
     assert cost(outcome.routes, positions) == 2 + 10
@@ -76,21 +80,21 @@ def test_windows_order_the_stops():
     # Node 1 (1 km) only after 10 min, node 2 (3 km) before 5 min: 2 first, then 1.
     positions = [1, 3]
     windows = [[], [(600, 10_000)], [(0, 300)]]
-    outcome = solve_routes(problem(positions, windows=windows), 1.0)
+    outcome = solve_routes(problem(positions, windows=windows), WORK)
     assert outcome is not None and outcome.routes == [[2, 1]]
 
 
 def test_energy_is_a_constraint_and_an_impossible_stop_is_left_out():
     # 10 units per km; 60 units take the van to 3 km and back, not to 4.
     positions = [1, 3, 4]
-    outcome = solve_routes(problem(positions, energy_capacity=60), 1.0)
+    outcome = solve_routes(problem(positions, energy_capacity=60), WORK)
     assert outcome is not None
     assert sorted(outcome.routes[0]) == [1, 2]
 
 
 def test_a_fixed_cost_keeps_the_second_van_home():
     positions = [1, 1]
-    outcome = solve_routes(problem(positions, vans=2, fixed=10**6), 1.0)
+    outcome = solve_routes(problem(positions, vans=2, fixed=10**6), WORK)
     assert outcome is not None
     assert sorted(len(r) for r in outcome.routes) == [0, 2]
 
