@@ -352,7 +352,9 @@ def test_sigkill_of_a_celery_worker_takes_its_solvers_along(broker, services):
         assert solvers
         os.kill(worker.process.pid, signal.SIGKILL)  # the worker alone, not its group
         worker.process.wait()
-        assert wait_gone(solvers, within_s=2.0) == []
+        # a solver the pool was still starting when its parent died exits as soon as its
+        # start-up sees the parent gone: seconds on a loaded machine
+        assert wait_gone(solvers, within_s=10.0) == []
         httpx.delete(f"{server.url}/v1/jobs/{job_id}")
     finally:
         server.close()

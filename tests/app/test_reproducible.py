@@ -1,5 +1,5 @@
 """The same request gives the same answer: every OpenAPI example of /v1/plans and
-/v1/fleet-plans sent three times — once while two other processes keep both cores busy — to a
+/v1/fleet-plans sent three times — once while another solve keeps both cores busy — to a
 real server with two worker processes, and as a job, answers byte for byte the same, but for
 the timing fields the OpenAPI document names (``solver.runtime_s``). And a status claims only
 what was proven: a round trip proven optimal, a charging day's order proven but its charges
@@ -56,8 +56,9 @@ def without_timing(answer: Any) -> Any:
 
 @contextlib.contextmanager
 def both_cores_busy() -> Iterator[None]:
-    """Two other solves of the service (processes at its workers' priority) on both cores."""
-    with busy_core(WORKER_NICENESS), busy_core(WORKER_NICENESS):
+    """Another solve of the service (a process at its workers' priority) beside this one:
+    both cores busy."""
+    with busy_core(WORKER_NICENESS):
         yield
 
 
