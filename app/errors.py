@@ -16,6 +16,7 @@ from app.execution import UnavailableError
 from core.exceptions import (
     CoreError,
     LimitExceededError,
+    ServerLimitError,
     ServiceUnavailableError,
     TooMuchToWaitForError,
 )
@@ -51,7 +52,7 @@ def problem(
 
 def core_problem(error: CoreError) -> dict[str, Any]:
     """The 422 problem of a core error, naming its field."""
-    if isinstance(error, TooMuchToWaitForError):  # valid, but for a job: 413 like a large body
+    if isinstance(error, TooMuchToWaitForError | ServerLimitError):  # valid, but too large
         status, title = 413, "Request too large"
     elif isinstance(error, LimitExceededError):
         status, title = 422, "Limit exceeded"

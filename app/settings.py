@@ -10,6 +10,7 @@ from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 from core.params import MAX_STOPS, MAX_TRACE_SAMPLES
+from core.planning.model import MAX_VEHICLES
 
 
 class Settings(BaseSettings):
@@ -40,7 +41,13 @@ class Settings(BaseSettings):
         None, description="When set, every /v1 request needs this value in X-API-Key."
     )
     max_stops: int = Field(
-        500, ge=1, le=MAX_STOPS, description=f"Most stops in one round (at most {MAX_STOPS})."
+        1000, ge=1, le=MAX_STOPS, description=f"Most stops in one round (at most {MAX_STOPS})."
+    )
+    max_vehicles: int = Field(
+        250,
+        ge=1,
+        le=MAX_VEHICLES,
+        description=f"Most vans in one fleet plan (at most {MAX_VEHICLES}).",
     )
     max_trace_samples: int = Field(
         200_000,
@@ -49,7 +56,12 @@ class Settings(BaseSettings):
         description="Most samples in one simulated trace (55 h at 1 Hz; at most "
         f"{MAX_TRACE_SAMPLES:,}).",
     )
-    max_body_bytes: int = Field(10_000_000, ge=1024, description="Largest request body [bytes].")
+    max_body_bytes: int = Field(
+        64_000_000,
+        ge=1024,
+        description="Largest request body [bytes]: 1,000 stops with their matrices take about "
+        "20 MB.",
+    )
     max_study_cell_stops: int = Field(
         2000, ge=1, description="Most cells × stops in one scenario study."
     )

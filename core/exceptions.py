@@ -102,6 +102,11 @@ class LimitExceededError(CoreError):
     """An input is larger than the configured limit (stops, samples...)."""
 
 
+class ServerLimitError(LimitExceededError):
+    """A request larger than the server is configured to plan (its stops, its vans): the size,
+    not the content, is refused."""
+
+
 class TooMuchToWaitForError(LimitExceededError):
     """A request that is valid but implies more work than a synchronous answer may take (the
     simulated time of a study): it can run as a job."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from app import connectors
 from app.operations.answers import attribution, energy
-from app.operations.limits import check_round, search_limits
+from app.operations.limits import check_fleet_size, search_limits
 from app.operations.plan import plan_response
 from app.operations.vans import van_of
 from app.schemas.fleet import (
@@ -32,7 +32,7 @@ from core.planning.model import (
 def fleet_problem(request: FleetPlanRequest, settings: Settings) -> FleetProblem:
     """The core problem of a fleet plan request, within the server's limits; a van's own
     errors name it (``vehicles[1].battery.min_soc``)."""
-    check_round(request, settings)
+    check_fleet_size(request, len(request.vehicles), settings)
     vehicles = []
     for index, vehicle in enumerate(request.vehicles):
         try:
@@ -80,9 +80,8 @@ def fleet_response(
             grid_kwh=result.grid_kwh,
             vehicles_used=result.vehicles_used,
         ),
-        # The fleet search never proves optimality: the best found within the time limit.
         solver=FleetSolverOut(
-            status="feasible",
+            status=result.status,
             objective=result.objective,
             objective_value=result.objective_value,
             runtime_s=result.runtime_s,

@@ -5,16 +5,26 @@ from __future__ import annotations
 from typing import Any
 
 from app.settings import Settings
-from core.exceptions import LimitExceededError
+from core.exceptions import ServerLimitError
 from core.planning.model import WORK_SHARE, FleetFields, PlanFields, RoundFields
 
 
 def check_round(request: RoundFields, settings: Settings) -> None:
     """A round within the server's limit of stops."""
     if len(request.stops) > settings.max_stops:
-        raise LimitExceededError(
+        raise ServerLimitError(
             f"{len(request.stops)} stops; this server plans at most {settings.max_stops}",
             "stops",
+        )
+
+
+def check_fleet_size(request: FleetFields, vehicles: int, settings: Settings) -> None:
+    """A fleet within the server's limits of stops and vans."""
+    check_round(request, settings)
+    if vehicles > settings.max_vehicles:
+        raise ServerLimitError(
+            f"{vehicles} vehicles; this server plans fleets of at most {settings.max_vehicles}",
+            "vehicles",
         )
 
 

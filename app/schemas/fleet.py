@@ -7,9 +7,14 @@ from pydantic import Field
 from app.schemas.base import ApiModel, AttributionOut, DistanceSourceOut, EnergyKwh, VanRequest
 from app.schemas.plans import AnswerOptions, PlanResponse
 from core.params import Objective
-from core.planning.model import FleetFields, ShiftFields, UnassignedReason, vehicles_field
+from core.planning.model import (
+    FleetFields,
+    FleetStatus,
+    ShiftFields,
+    UnassignedReason,
+    vehicles_field,
+)
 from core.routing.effort import SearchEnd
-from core.routing.tsp import SolverStatus
 
 
 class FleetVehicleRequest(VanRequest, ShiftFields):
@@ -60,8 +65,10 @@ class FleetTotals(ApiModel):
 class FleetSolverOut(ApiModel):
     """How the fleet search ended."""
 
-    status: SolverStatus = Field(
-        ..., description="feasible: the best found (a fleet's search proves nothing)."
+    status: FleetStatus = Field(
+        ...,
+        description="feasible: the best routes found that hold (a fleet's search proves "
+        "nothing); no_solution: no route serves any stop (unassigned says why).",
     )
     stopped_by: SearchEnd = Field(
         "work",

@@ -189,7 +189,7 @@ def rest_to_rest(
     """
     if distance_m <= 0:
         return np.zeros(max(round(duration_s / dt_s), 0) + 1)
-    least_s = fastest_s(distance_m, accel_mps2, top_mps)
+    least_s = float(fastest_s(distance_m, accel_mps2, top_mps))
     steps = max(math.ceil(max(duration_s, least_s) / dt_s - 1e-9), 2)
     while True:
         trace = _trapezoid(distance_m, steps * dt_s, accel_mps2, dt_s)
@@ -211,12 +211,17 @@ def _trapezoid(distance_m: float, total_s: float, accel_mps2: float, dt_s: float
     return trace * (distance_m / trace_distance_m(trace, dt_s))
 
 
-def fastest_s(distance_m: float, accel_mps2: float, top_mps: float) -> float:
+def fastest_s(
+    distance_m: float | FloatArray, accel_mps2: float, top_mps: float
+) -> float | FloatArray:
     """The least time a van covers ``distance_m`` from rest to rest with ``accel_mps2`` and a
-    top speed of ``top_mps`` [s]."""
-    if distance_m <= top_mps * top_mps / accel_mps2:
-        return 2.0 * math.sqrt(distance_m / accel_mps2)
-    return distance_m / top_mps + top_mps / accel_mps2
+    top speed of ``top_mps`` [s]: accelerating then braking, with a cruise at the top speed
+    between when the distance allows one. Elementwise over an array of distances."""
+    distance = np.asarray(distance_m, dtype=float)
+    ramps = 2.0 * np.sqrt(distance / accel_mps2)
+    cruise = distance / top_mps + top_mps / accel_mps2
+    least = np.where(distance <= top_mps * top_mps / accel_mps2, ramps, cruise)
+    return float(least) if least.ndim == 0 else least
 
 
 #: Spacing of the distance grid on which a road speed profile is driven [m].

@@ -45,8 +45,8 @@ from core.routing.tsp import SolverStatus
 DEPOT_CHARGER_ID = "depot"
 #: Longest round the planner simulates [s] (a week): longer inputs are mistakes.
 MAX_ROUND_S = 7 * 86_400.0
-#: Most vans in one fleet plan.
-MAX_VEHICLES = 100
+#: Most vans in one fleet plan (the server's setting may allow fewer).
+MAX_VEHICLES = 1000
 #: Longest a round's search may run [s] when the request gives no limit; its work (a tenth, a
 #: reference second) proves rounds of up to about 60 stops optimal and brings larger ones
 #: within about 0.1 % of LKH-3.
@@ -586,6 +586,10 @@ class FleetRoute:
     plan: PlanResult
 
 
+#: How a fleet's search ended: routes that hold, or none that serves a stop.
+FleetStatus = Literal["feasible", "no_solution"]
+
+
 @dataclass(frozen=True)
 class FleetResult:
     """The fleet's plan for the day.
@@ -630,3 +634,10 @@ class FleetResult:
     distance_source: DistanceSource
     warnings: list[str]
     stopped_by: SearchEnd = "work"
+
+    @property
+    def status(self) -> FleetStatus:
+        """``feasible``: routes that hold (a fleet's search proves nothing); ``no_solution``:
+        stops were asked for and no route serves any."""
+        served = any(route.plan.stops for route in self.routes)
+        return "feasible" if served or not self.unassigned else "no_solution"

@@ -28,6 +28,8 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
         largest = kind.arc_cost.max(axis=1)
         cost_bound = max(cost_bound, int(largest.sum() + largest[0] * len(day.shifts)))
     fixed = cost_bound + 1 if minimize_vehicles else 0
+    # one matrix per kind of van, shared by its vans (and so by the solvers' vehicle types)
+    energies = {id(kind): energy_units_up(kind.energy_j) for kind in kinds}
     specs = []
     for v, shift in enumerate(day.shifts):
         estimates, budget = day.estimates[v], rules.budgets_j[v]
@@ -35,7 +37,7 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
         specs.append(
             VehicleSpec(
                 arc_cost=estimates.arc_cost,
-                energy=None if budget is None else energy_units_up(estimates.energy_j),
+                energy=None if budget is None else energies[id(estimates)],
                 energy_capacity=0 if budget is None else energy_units_down(budget),
                 payload_capacity_g=payload_units_down(shift.problem.van.payload_kg),
                 shift_s=(math.ceil(start_s), math.floor(end_s)),

@@ -230,21 +230,16 @@ def client_legs_too_fast(legs: Legs, accel_mps2: float) -> str | None:
     naming the first such cell; None when every leg can be driven in its time."""
     if legs.source != "client":
         return None
-    n = legs.distance_m.shape[0]
-    short = [
-        (i, j, fastest_s(float(legs.distance_m[i, j]), accel_mps2, MAX_SPEED_MPS))
-        for i in range(n)
-        for j in range(n)
-        if i != j and legs.distance_m[i, j] > 0
-    ]
-    short = [(i, j, least) for i, j, least in short if legs.duration_s[i, j] < least - 1e-9]
-    if not short:
+    least = np.asarray(fastest_s(legs.distance_m, accel_mps2, MAX_SPEED_MPS))
+    short = np.argwhere((legs.distance_m > 0) & (legs.duration_s < least - 1e-9))
+    if not short.size:
         return None
-    i, j, least = short[0]
+    i, j = (int(k) for k in short[0])
+    count = len(short)
     return (
         f"matrix.durations_s[{i}][{j}]: {legs.duration_s[i, j]:g} s for "
         f"{legs.distance_m[i, j]:g} m is faster than a van can drive from rest to rest (at least "
-        f"{least:.1f} s); {len(short)} such leg{'s' if len(short) > 1 else ''} of the matrix take "
+        f"{least[i, j]:.1f} s); {count} such leg{'s' if count > 1 else ''} of the matrix take "
         "what the van needs"
     )
 

@@ -69,6 +69,10 @@ class Effort:
         """A part of the work, under the same deadline."""
         return replace(self, work_s=self.work_s * fraction)
 
+    def keeping(self, reserve_s: float) -> Effort:
+        """The same work with ``reserve_s`` [s] kept before the deadline for what follows."""
+        return replace(self, deadline=self.deadline - reserve_s)
+
     def left_s(self) -> float:
         """Time to the deadline [s]."""
         return self.deadline - time.perf_counter()

@@ -386,8 +386,6 @@ def _pyvrp_routes(
         collect_stats=False,
         initial_solution=start,
     )
-    if not result.is_feasible():
-        return None, stop.ended
     routes: list[list[int]] = [[] for _ in problem.vehicles]
     taken = [0] * len(model.type_vans)
     for route in result.best.routes():
@@ -396,7 +394,58 @@ def _pyvrp_routes(
         taken[kind] += 1
         visits = route.schedule()[1:-1]
         routes[van] = [model.client_node[a.idx] if a.is_client() else 0 for a in visits]
+    if not result.is_feasible():  # the best it found, less the stops that break a rule
+        routes = [_kept(problem, v, route) for v, route in enumerate(routes)]
     return routes, stop.ended
+
+
+def _kept(problem: RoutingInput, v: int, route: list[int]) -> list[int]:
+    """Van ``v``'s ``route`` with only the stops it serves in order within their windows and
+    its payload, back by the end of its shift and within its energy budget: a partial route
+    from an infeasible one."""
+    vehicle = problem.vehicles[v]
+    first, last = vehicle.shift_s
+    clock, place = float(first), vehicle.start
+    load = vehicle.initial_load_g
+    kept: list[int] = []
+    for node in route:
+        arrive = clock + problem.service_s[place] + problem.travel_s[place, node]
+        if not node:  # back to reload: its time is the reload's
+            clock, place, load = arrive + vehicle.reload_s, 0, 0
+            kept.append(0)
+            continue
+        opens = _opening(problem.windows_s[node], arrive)
+        if opens is None or load + problem.demand_g[node] > vehicle.payload_capacity_g:
+            continue
+        clock, place, load = max(arrive, opens), node, load + int(problem.demand_g[node])
+        kept.append(node)
+    kept = trips_tidied(kept, vehicle.start != 0)
+    while kept and _back_s(problem, v, kept) > last:
+        kept = trips_tidied(kept[:-1], vehicle.start != 0)
+    return _within_energy(problem, v, kept)
+
+
+def _opening(windows: list[tuple[int, int]], arrive: float) -> float | None:
+    """When service may start at a place reached at ``arrive`` [s]; None when every window
+    has closed (no window: at once)."""
+    if not windows:
+        return arrive
+    return next((max(arrive, a) for a, b in windows if arrive <= b), None)
+
+
+def _back_s(problem: RoutingInput, v: int, route: list[int]) -> float:
+    """When van ``v`` is back at the depot after ``route`` [s], waiting for every window."""
+    vehicle = problem.vehicles[v]
+    clock, place = float(vehicle.shift_s[0]), vehicle.start
+    for node in route:
+        clock += problem.service_s[place] + problem.travel_s[place, node]
+        if node:
+            opens = _opening(problem.windows_s[node], clock)
+            clock = math.inf if opens is None else opens
+        else:
+            clock += vehicle.reload_s
+        place = node
+    return clock + problem.service_s[place] + problem.travel_s[place, 0]
 
 
 def _pyvrp_start(model: _PyvrpModel, initial: list[list[int]] | None) -> pyvrp.Solution | None:

@@ -8,6 +8,7 @@ import datetime as dt
 import pytest
 
 from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
+from tests.app.apps import app_client
 
 PROBLEM = "application/problem+json"
 
@@ -130,6 +131,25 @@ def test_stops_no_van_can_serve_are_listed_not_errors(client):
     unassigned = {u["id"]: u["reason"] for u in response.json()["unassigned"]}
     assert unassigned == {body["stops"][0]["id"]: "capacity", body["stops"][1]["id"]: "time_window"}
     assert_routes_hold(response.json(), body)
+    assert response.json()["solver"]["status"] == "feasible"
+
+
+def test_a_fleet_that_serves_no_stop_says_so(client):
+    body = copy.deepcopy(FLEET_PLAN_EXAMPLE)
+    for stop in body["stops"]:
+        stop["time_windows"] = [{"start": "04:00", "end": "05:00"}]  # before every shift
+    answer = client.post("/v1/fleet-plans", json=body).json()
+    assert answer["routes"] == [] and len(answer["unassigned"]) == len(body["stops"])
+    assert answer["solver"]["status"] == "no_solution"
+
+
+def test_more_vans_than_the_server_plans_is_a_413_naming_vehicles():
+    body = copy.deepcopy(FLEET_PLAN_EXAMPLE)
+    small = app_client(max_vehicles=1)
+    response = small.post("/v1/fleet-plans", json=body)
+    assert response.status_code == 413
+    assert response.json()["errors"][0]["field"] == "vehicles"
+    assert "at most 1" in response.json()["detail"]
 
 
 def _with(change) -> dict:
@@ -154,7 +174,7 @@ def _with(change) -> dict:
             "vehicles[1].battery.min_soc",
         ),
         (lambda b: b.update(vehicles=[]), "vehicles"),
-        (lambda b: b.update(vehicles=b["vehicles"] * 60), "vehicles"),
+        (lambda b: b.update(vehicles=b["vehicles"] * 501), "vehicles"),  # over 1,000
         (
             lambda b: b["stops"][2].update(time_windows=[{"start": "10:00", "end": "09:00"}]),
             "stops[2].time_windows[0].end",

@@ -104,3 +104,19 @@ def test_the_solver_units_round_what_is_taken_up_and_limits_down():
     assert energy_units_down(719.9) == 1
     assert payload_units_up([0.3, 60.0]).tolist() == [300, 60_000]
     assert payload_units_down(0.0015) == 1
+
+
+def test_a_route_the_search_left_infeasible_keeps_the_stops_that_fit():
+    """PyVRP's best may break a rule when its search was cut short: the van keeps, in order,
+    the stops it reaches inside their windows and can carry, and is back within its shift."""
+    from core.routing.vrp import _kept
+
+    # stops at 1, 3, 5 and 2 km, 1 min per km: stop 2 (3 km) closes at 2 min; the van reaches
+    # it at 3 min after stop 1 → left out; stop 4 (2 kg) would overload the 3 kg van.
+    positions = [1, 3, 5, 2]
+    windows = [[], [], [(0, 120)], [], []]
+    routes = problem(positions, windows=windows, demand=[1000, 1000, 1000, 2000], payload=3000)
+    assert _kept(routes, 0, [1, 2, 3, 4]) == [1, 3]
+    # a shift that ends before the van is back from stop 3 (5 km, back at 10 min): stop 3 goes
+    short = problem(positions, horizon=500)
+    assert _kept(short, 0, [1, 3]) == [1]
