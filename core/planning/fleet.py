@@ -386,6 +386,28 @@ def _kind(day: FleetDay, v: int) -> str:
     return f"{problem.van.model_dump_json()}|{shift.start}|{shift.end}|{day.starts[v]}|{rules}"
 
 
+def _simulated(
+    day: FleetDay,
+    routes: list[list[int]],
+    before: dict[int, tuple[list[int], PlanResult]],
+    times: LearnedTimes,
+) -> dict[int, tuple[list[int], PlanResult]]:
+    """Each van's route and its simulated day: a route as it was ``before`` keeps its day
+    (the simulation depends on the route alone), a new one is simulated and teaches ``times``
+    the times it drove — so verification scales with the routes that changed."""
+    out: dict[int, tuple[list[int], PlanResult]] = {}
+    for v, route in enumerate(routes):
+        if not route:
+            continue
+        if v in before and before[v][0] == route:
+            out[v] = before[v]
+            continue
+        result = day.simulate(v, route)
+        times.learn(traced_seconds(day.order(v, route), result))
+        out[v] = (list(route), result)
+    return out
+
+
 def search(
     day: FleetDay, minimize_vehicles: bool, effort: Effort, charging: bool = False
 ) -> Routed:
@@ -403,7 +425,7 @@ def search(
     results: dict[int, PlanResult] = {}
     failures: dict[int, Failure] = {}
     initial: list[list[int]] | None = None
-    routes_before: list[list[int]] = [[] for _ in day.vans]
+    simulated: dict[int, tuple[list[int], PlanResult]] = {}
     ends: list[SearchEnd] = []
     rounds = 0
     reserve_s = VERIFY_RESERVE_S_PER_STOP * len(day.stop_nodes)
@@ -423,16 +445,8 @@ def search(
         # a re-solve that found nothing (out of time) keeps the routes that held before it
         kept = initial if initial is not None else [[] for _ in day.vans]
         routes = outcome.routes if outcome is not None else kept
-        # only the routes that changed are simulated again: the others' days are the same
-        before = {v: (routes_before[v], r) for v, r in results.items()}
-        results = {}
-        for v, route in enumerate(routes):
-            if route and v in before and before[v][0] == route:
-                results[v] = before[v][1]
-            elif route:
-                results[v] = day.simulate(v, route)
-                times.learn(traced_seconds(day.order(v, route), results[v]))
-        routes_before = [list(route) for route in routes]
+        simulated = _simulated(day, routes, simulated, times)
+        results = {v: result for v, (_, result) in simulated.items()}
         failures = {
             v: failure
             for v, result in results.items()
