@@ -11,11 +11,8 @@ from dataclasses import dataclass
 from multiprocessing import Queue, get_context
 
 import numpy as np
-from pyvrp import Client, Location, ProblemData, VehicleType, solve
-from pyvrp import Depot as PyvrpDepot
-from pyvrp.stop import MaxRuntime
 
-from benchmarks.common import REFERENCE, print_table
+from benchmarks.common import REFERENCE, print_table, pyvrp_vrptw
 from core.params import PRESETS, BatteryParams, Depot, RoadMatrix, Stop, TimeWindow, Weather
 from core.planning.fleet import FIRST_SOLVE_SHARE, plan_fleet
 from core.planning.model import FleetProblem, FleetResult, FleetVehicle, PlanProblem
@@ -163,32 +160,20 @@ def pyvrp_solomon(
 ) -> tuple[float, int]:
     """PyVRP on the same instance at the same budget: distance [units] and vans; with
     ``minimize_vehicles`` a fixed cost per van larger than any set of routes."""
-    per_minute = PYVRP_SCALE / instance.minutes_per_unit
-    distance = np.rint(instance.distance * PYVRP_SCALE).astype(np.int64)
-    n = distance.shape[0]
-    fixed = int(distance.max() * 2 * n) if minimize_vehicles else 0
-    horizon = int(instance.window_min[0][1] * per_minute)
-    data = ProblemData(
-        [Location(0.0, 0.0) for _ in range(n)],
-        [
-            Client(
-                location=k,
-                delivery=[int(instance.demand[k])],
-                service_duration=round(instance.service_min[k] * per_minute),
-                tw_early=int(a * per_minute),
-                tw_late=int(b * per_minute),
-            )
-            for k, (a, b) in enumerate(instance.window_min)
-            if k
-        ],
-        [PyvrpDepot(location=0, tw_early=0, tw_late=horizon)],
-        [VehicleType(VANS, capacity=[int(instance.capacity)], fixed_cost=fixed, tw_late=horizon)],
-        [distance],
-        [distance],
+    distance, vans, served = pyvrp_vrptw(
+        instance.distance,
+        instance.demand,
+        instance.service_min,
+        instance.window_min,
+        instance.minutes_per_unit,
+        instance.capacity,
+        VANS,
+        time_limit_s,
+        fixed_cost=minimize_vehicles,
+        scale=PYVRP_SCALE,
     )
-    result = solve(data, stop=MaxRuntime(time_limit_s), seed=1, display=False)
-    assert result.is_feasible()
-    return result.best.distance() / PYVRP_SCALE, result.best.num_routes()
+    assert served == len(instance.window_min) - 1
+    return distance, vans
 
 
 def solomon_table(budgets: tuple[float, ...] = (10.0, 60.0)) -> None:

@@ -144,3 +144,56 @@ def running_server(env: dict[str, str] | None = None) -> Iterator[str]:
         yield server.url
     finally:
         server.close()
+
+
+def pyvrp_vrptw(
+    distance: np.ndarray,
+    demand: Sequence[float],
+    service_min: Sequence[float],
+    window_min: Sequence[tuple[int, int]],
+    minutes_per_unit: float,
+    capacity: float,
+    vans: int,
+    budget_s: float,
+    fixed_cost: bool = False,
+    scale: int = 100,
+) -> tuple[float, int, int]:
+    """PyVRP alone on a VRPTW instance (the depot first; one unit of distance is one of time,
+    ``minutes_per_unit`` minutes; windows in whole minutes) for ``budget_s``, in ``scale``-ths
+    of a unit; ``fixed_cost``: a cost per van larger than any set of routes. Its distance
+    [units], vans and the stops served (0 when its best breaks a rule)."""
+    from pyvrp import Client, Depot, Location, ProblemData, VehicleType, solve
+    from pyvrp.stop import MaxRuntime
+
+    per_minute = scale / minutes_per_unit
+    arcs = np.rint(distance * scale).astype(np.int64)
+    n = arcs.shape[0]
+    horizon = int(window_min[0][1] * per_minute)
+    data = ProblemData(
+        [Location(0.0, 0.0) for _ in range(n)],
+        [
+            Client(
+                location=k,
+                delivery=[int(demand[k])],
+                service_duration=round(service_min[k] * per_minute),
+                tw_early=int(a * per_minute),
+                tw_late=int(b * per_minute),
+            )
+            for k, (a, b) in enumerate(window_min)
+            if k
+        ],
+        [Depot(location=0, tw_early=0, tw_late=horizon)],
+        [
+            VehicleType(
+                vans,
+                capacity=[int(capacity)],
+                fixed_cost=int(arcs.max() * 2 * n) if fixed_cost else 0,
+                tw_late=horizon,
+            )
+        ],
+        [arcs],
+        [arcs],
+    )
+    result = solve(data, stop=MaxRuntime(budget_s), seed=1, display=False)
+    served = result.best.num_clients() if result.is_feasible() else 0
+    return result.best.distance() / scale, result.best.num_routes(), served

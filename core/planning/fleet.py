@@ -70,17 +70,23 @@ from core.routing.vrp import solve_routes
 
 #: Share of the work the first solve has; each re-solve after a failed verification has
 #: :data:`RESOLVE_SHARE`, at most :data:`MAX_RESOLVES` times.
-FIRST_SOLVE_SHARE = 0.6
-RESOLVE_SHARE = 0.1
+FIRST_SOLVE_SHARE = 0.8
+RESOLVE_SHARE = 0.05
 MAX_RESOLVES = 4
 #: A tightened energy budget is cut this much below the simulated need, so the next
 #: solution does not land on the edge again.
 TIGHTEN_MARGIN = 0.98
 #: Stops whose arcs are driven before the first solve to learn the simulation's driving times.
 CALIBRATION_STOPS = 12
-#: Time each solve leaves before the deadline for simulating its routes, per stop [s]: the
-#: verification of 1,000 stops on 118 routes took 5.1 s on the reference machine (R1_10_1).
+#: Time each solve leaves before the deadline for simulating its routes, per stop, at least
+#: [s]: the verification of 1,000 stops on 118 routes took 5.1 s on the reference machine
+#: (R1_10_1); more when a sample route simulated before the search says this machine, under
+#: its present load, is slower (:func:`verification_reserve_s`).
 VERIFY_RESERVE_S_PER_STOP = 0.008
+#: Stops of that sample route.
+SAMPLE_STOPS = 8
+#: The reserve per stop as a multiple of the sample's time per stop (routes differ).
+VERIFY_RESERVE_FACTOR = 1.5
 
 
 def plan_fleet(
@@ -304,6 +310,19 @@ def calibrate(day: FleetDay, times: LearnedTimes) -> None:
     times.learn(driven)
 
 
+def verification_reserve_s(day: FleetDay) -> float:
+    """Time to keep before the deadline for simulating the routes a solve finds [s]: every
+    stop of the day at :data:`VERIFY_RESERVE_FACTOR` times the time per stop of a sample
+    route's simulation, timed now — so a slower or busier machine keeps more."""
+    sample = [k for k in day.stop_nodes if k not in day.unreachable][:SAMPLE_STOPS]
+    if not sample:
+        return 0.0
+    started = time.perf_counter()
+    day.simulate(day.vans[0], sample)
+    per_stop_s = (time.perf_counter() - started) / len(sample) * VERIFY_RESERVE_FACTOR
+    return max(per_stop_s, VERIFY_RESERVE_S_PER_STOP) * len(day.stop_nodes)
+
+
 def _failure(day: FleetDay, v: int, result: PlanResult) -> Failure | None:
     shift = day.shifts[v]
     return route_failure(
@@ -428,7 +447,8 @@ def search(
     simulated: dict[int, tuple[list[int], PlanResult]] = {}
     ends: list[SearchEnd] = []
     rounds = 0
-    reserve_s = VERIFY_RESERVE_S_PER_STOP * len(day.stop_nodes)
+    # a limit too short for the verification's reserve still leaves the search half of it
+    reserve_s = min(verification_reserve_s(day), effort.left_s() / 2)
     while rounds <= MAX_RESOLVES:
         if rounds and effort.left_s() <= reserve_s:
             ends.append("time_limit")

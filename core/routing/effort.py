@@ -12,9 +12,10 @@ Rates, measured on the reference machine (uniform and clustered instances):
 
 - the round trip's local search (:mod:`core.routing.ils`): kicks per second by the number of
   places, interpolated log-log in :data:`KICKS_PER_S`;
-- PyVRP's iterated local search: ``1800 · (25 / clients)^0.6`` iterations per second (25
-  clients: 1,800; 100: 690; 1,000: 206), the marginal rate over random VRPTW instances with
-  tight and wide windows;
+- PyVRP's iterated local search: ``3400 · (25 / clients)^0.6`` iterations per second with
+  every stop required (25 clients: 3,400; 100: 1,480; 1,000: 372), ``1800 · (25 /
+  clients)^0.6`` with every stop optional (25: 1,800; 100: 690; 1,000: 206), the marginal
+  rates over random VRPTW instances with tight and wide windows (the lower);
 - OR-Tools' guided local search (:mod:`core.routing.vrp`): ``500 · (20 / places)^1.4``
   solutions per second (20 places: 500; 40: 190; 100: 52; 200: 20), on random instances with
   windows and an energy budget (long runs: the first solutions come faster);
@@ -38,8 +39,10 @@ SearchEnd = Literal["work", "proof", "time_limit"]
 #: Kicks per reference second of the round trip's local search, by places.
 KICKS_PER_S = ((20, 14_000), (40, 9_700), (80, 8_900), (150, 6_400), (300, 3_800),
                (600, 2_500), (1_000, 1_800))  # fmt: skip
-#: PyVRP's iterations per reference second: ``PYVRP_RATE · (PYVRP_SIZE / clients)^PYVRP_EXPONENT``.
-PYVRP_RATE = 1_800.0
+#: PyVRP's iterations per reference second: ``PYVRP_RATE · (PYVRP_SIZE / clients)^PYVRP_EXPONENT``
+#: with every stop required, ``PYVRP_OPTIONAL_RATE · …`` with every stop optional.
+PYVRP_RATE = 3_400.0
+PYVRP_OPTIONAL_RATE = 1_800.0
 PYVRP_SIZE = 25.0
 PYVRP_EXPONENT = 0.6
 #: OR-Tools' routing solutions per reference second:
@@ -86,9 +89,11 @@ class Effort:
         rate = float(np.exp(np.interp(math.log(max(places, 2)), table[:, 0], table[:, 1])))
         return max(int(self.work_s * rate), 0)
 
-    def pyvrp_iterations(self, clients: int) -> int:
-        """PyVRP's iterations in this work."""
-        rate = PYVRP_RATE * (PYVRP_SIZE / max(clients, 1)) ** PYVRP_EXPONENT
+    def pyvrp_iterations(self, clients: int, optional: bool = False) -> int:
+        """PyVRP's iterations in this work, its stops required or ``optional``."""
+        rate = (PYVRP_OPTIONAL_RATE if optional else PYVRP_RATE) * (
+            PYVRP_SIZE / max(clients, 1)
+        ) ** PYVRP_EXPONENT
         return max(int(self.work_s * rate), 1)
 
     def ortools_solutions(self, places: int) -> int:

@@ -3,17 +3,22 @@ budget per van, each van with its own costs.
 
 The solver sees integers only; the caller rounds explicitly: seconds for time, grams for
 payload, tenths of a watt-hour for energy, and the objective's own unit for the arc costs.
-A stop that no route can take is dropped for a penalty larger than any set of routes costs,
-so stops are dropped only when they cannot be served, never to save cost.
+A stop is left out only when no route can take it, never to save cost: OR-Tools pays a
+penalty larger than any set of routes costs, PyVRP forgoes a prize larger than serving any
+stop costs.
 
 Two engines, each where it is strongest (``benchmarks/bench_fleet.py``):
 
 1. PyVRP's iterated local search (Wouda, Lan & Kool 2024) on windows, shifts and payload: on
    Solomon's instances within a fraction of a percent of the best known routes. A stop with
-   several windows is a group of alternatives, one per window. It ends after its work's
-   iterations (:mod:`core.routing.effort`) or :data:`ITERATIONS_PER_STOP` iterations per stop
-   without improvement, whichever comes first — seeded, so the same routes for the same input
-   and effort — or, cut short, at the deadline.
+   several windows is a group of alternatives, one per window. Every stop is required at
+   first (its fastest search: 2–3 times the iterations per second of one with optional
+   stops); when that finds no routes serving them all within :data:`REQUIRED_SHARE` of its
+   work, the rest of the work goes to a search with every stop optional for a prize, so a
+   partial plan is there. It ends after its work's iterations (:mod:`core.routing.effort`) or
+   :data:`ITERATIONS_PER_STOP` iterations per stop without improvement, whichever comes
+   first — seeded, so the same routes for the same input and effort — or, cut short, at the
+   deadline.
 2. OR-Tools' routing library with every constraint as a dimension, the energy budget
    included, and the cost of waiting for a window: it takes over PyVRP's routes when they
    break an energy budget (less the stops that do not fit) or when waiting has a cost,
@@ -39,6 +44,21 @@ IntMatrix = NDArray[np.int64]
 
 #: Iterations per stop without an improvement after which PyVRP ends before its work is done.
 ITERATIONS_PER_STOP = 200
+#: Share of PyVRP's work (and of its time) for finding routes that serve every stop before
+#: it searches with stops optional.
+REQUIRED_SHARE = 0.2
+#: PyVRP weighs a second late (its penalties) and a second of waiting (its neighbourhoods)
+#: against one unit of cost, with defaults tuned on instances whose arcs cost one per unit of
+#: time (Solomon's). It is given costs in units of the square root of what a second of
+#: driving costs (:func:`_cost_per_s`), measured in the same runs against PyVRP: in metres
+#: against seconds (about 16 m a second) time counted too little and R1_10_1 (tight windows)
+#: came 1.5 % longer; at one per second it counted too much and C201 (wide windows, the
+#: payload binding) kept three long routes (+2.2 %) where PyVRP finds four shorter; the
+#: root between them met PyVRP on both. Fixed costs per van keep their scale: the search
+#: that empties a route needs the room. The bounds of the scale [objective units per s]:
+_SCALE_BOUNDS = (0.01, 100.0)
+#: PyVRP's cost of a solution that breaks a constraint.
+_INFEASIBLE = np.iinfo(np.int64).max
 #: The searches overshoot their limit by a few milliseconds; they get this much less [s].
 _STOP_MARGIN_S = 0.01
 #: Longest cap OR-Tools is given [s] (a day): a deadline that never comes is no number it takes.
@@ -246,13 +266,23 @@ def _kind(vehicle: VehicleSpec) -> tuple[object, ...]:
     )
 
 
-def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
+def _pyvrp_model(problem: RoutingInput, required: bool) -> _PyvrpModel:
     """Vans alike but for their order share a vehicle type (the search breaks the symmetry
     itself; the first-listed vans get the routes); a place with several windows is a group of
-    clients, one per window, of which the route visits one."""
+    clients, one per window, of which the route visits one. Every stop ``required``, or
+    optional for a prize (:func:`_prize`)."""
     n = problem.travel_s.shape[0]
     horizon = int(problem.horizon_s)
     never = horizon + 1
+    large_fixed = max((v.fixed_cost for v in problem.vehicles), default=0) > len(problem.vehicles)
+    scale = _cost_scale(problem, large_fixed)
+
+    def above_routes(cost: int) -> int:
+        # a cost above any set of routes stays above them once each arc's is rounded
+        return math.ceil(cost / scale) + n + len(problem.vehicles)
+
+    prize = _prize(problem, scale, large_fixed)
+
     locations = [pyvrp.Location(0.0, 0.0) for _ in range(n)]
     clients: list[pyvrp.Client] = []
     client_node: list[int] = []
@@ -272,20 +302,19 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
                     service_duration=int(problem.service_s[node]),
                     tw_early=int(opens),
                     tw_late=int(closes),
-                    prize=int(problem.drop_penalty),
-                    required=False,
+                    prize=0 if required else prize,
+                    required=required and len(windows) == 1,
                     group=len(groups) if len(windows) > 1 else None,
                 )
             )
             client_node.append(node)
         if len(windows) > 1:
-            groups.append(pyvrp.ClientGroup(members, required=False))
+            groups.append(pyvrp.ClientGroup(members, required=required))
         node_clients[node] = members
     # A large fixed cost keeps vans home; the small steps between the vans' fixed costs only
     # say the first-listed drive first, which the order of a type's vans says as well. One
     # type for vans alike but for those steps: 25 types of one van each found a van more on
     # Solomon's RC101 than one type of 25 (PyVRP's route operators work within a type).
-    large_fixed = max((v.fixed_cost for v in problem.vehicles), default=0) > len(problem.vehicles)
     kinds: dict[tuple[object, ...], list[int]] = {}
     for v, vehicle in enumerate(problem.vehicles):
         kinds.setdefault(_kind(vehicle), []).append(v)
@@ -314,13 +343,13 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
         key = id(vehicle.arc_cost)
         if key not in matrices:
             matrices[key] = len(distance_matrices)
-            distance_matrices.append(np.asarray(vehicle.arc_cost, dtype=np.int64))
+            distance_matrices.append(np.rint(vehicle.arc_cost / scale).astype(np.int64))
         first, last = (int(t) for t in vehicle.shift_s)
         vehicle_types.append(
             pyvrp.VehicleType(
                 num_available=len(vans),
                 capacity=[int(vehicle.payload_capacity_g)],
-                fixed_cost=int(vehicle.fixed_cost) if large_fixed else 0,
+                fixed_cost=above_routes(vehicle.fixed_cost) if large_fixed else 0,
                 tw_early=first,
                 tw_late=last,
                 profile=matrices[key],
@@ -343,25 +372,72 @@ def _pyvrp_model(problem: RoutingInput) -> _PyvrpModel:
     return _PyvrpModel(data, client_node, node_clients, list(kinds.values()))
 
 
+def _cost_per_s(problem: RoutingInput) -> float:
+    """What the arcs cost per second of driving, on average over the arcs that exist and the
+    vans' cost matrices, within :data:`_SCALE_BOUNDS`."""
+    exists = problem.travel_s <= problem.horizon_s
+    driving = float(problem.travel_s[exists].mean()) if exists.any() else 0.0
+    costs = {id(v.arc_cost): v.arc_cost for v in problem.vehicles}.values()
+    cost = float(np.mean([matrix[exists].mean() for matrix in costs])) if costs else 0.0
+    if driving <= 0 or cost <= 0:
+        return 1.0
+    return float(np.clip(cost / driving, *_SCALE_BOUNDS))
+
+
+def _prize(problem: RoutingInput, scale: float, large_fixed: bool) -> int:
+    """Every stop's prize when stops are optional, in PyVRP's costs: more than serving any
+    stop can add to a route (the dearest arcs in and out of a place), and than a van when vans
+    have a fixed cost — so a stop is left out only where serving it breaks a rule, and the
+    same for every stop, so the most are served. A prize above every route
+    (:attr:`RoutingInput.drop_penalty`) would be worth more than any penalty PyVRP reaches
+    for breaking a rule, and its search would never leave a stop out."""
+    exists = problem.travel_s <= problem.horizon_s
+    costs = {id(v.arc_cost): np.where(exists, v.arc_cost, 0) for v in problem.vehicles}
+    dearest = max(int((m.max(axis=0) + m.max(axis=1)).max()) for m in costs.values())
+    fixed = max(v.fixed_cost for v in problem.vehicles) if large_fixed else 0
+    return math.ceil((dearest + fixed) / scale) + 2
+
+
+def _cost_scale(problem: RoutingInput, large_fixed: bool) -> float:
+    """What PyVRP's costs are divided by: see :data:`_SCALE_BOUNDS`."""
+    return 1.0 if large_fixed else math.sqrt(_cost_per_s(problem))
+
+
 class _Stop:
     """PyVRP's stopping criterion: its iterations (the work), no improvement in ``patience``
-    iterations, or the deadline — and which of them stopped it."""
+    iterations, or the deadline — and which of them stopped it. With ``give_up`` (iterations
+    and a ``time.perf_counter`` value), it also stops when either is reached and no solution
+    keeps every constraint yet; ``gave_up``: it stopped without one, but for the deadline."""
 
-    def __init__(self, iterations: int, patience: int, deadline: float) -> None:
-        self.left, self.patience, self.deadline = iterations, patience, deadline
-        self.best, self.idle = math.inf, 0
+    def __init__(
+        self,
+        iterations: int,
+        patience: int,
+        deadline: float,
+        give_up: tuple[int, float] | None = None,
+    ) -> None:
+        self.iterations, self.patience, self.deadline = iterations, patience, deadline
+        self.give_up = give_up
+        self.best, self.idle, self.done = math.inf, 0, 0
         self.ended: SearchEnd = "work"
+        self.gave_up = False
 
     def __call__(self, best_cost: float) -> bool:
         if best_cost < self.best:
             self.best, self.idle = best_cost, 0
         else:
             self.idle += 1
-        self.left -= 1
-        if time.perf_counter() >= self.deadline:
+        self.done += 1
+        now = time.perf_counter()
+        if now >= self.deadline:
             self.ended = "time_limit"
             return True
-        return self.left < 0 or self.idle > self.patience
+        spent = self.done > self.iterations or self.idle > self.patience
+        if self.give_up is not None and best_cost >= _INFEASIBLE:
+            iterations, moment = self.give_up
+            self.gave_up = spent or self.done > iterations or now >= moment
+            return self.gave_up
+        return spent
 
 
 def _pyvrp_routes(
@@ -369,23 +445,26 @@ def _pyvrp_routes(
 ) -> tuple[list[list[int]] | None, SearchEnd]:
     """PyVRP's best feasible routes per van after the effort's iterations (or
     :data:`ITERATIONS_PER_STOP` per stop without improvement); None when it has none; and how
-    it stopped."""
-    model = _pyvrp_model(problem)
-    if not model.client_node:
-        return [[] for _ in problem.vehicles], "work"
+    it stopped. Every stop required first; optional after :data:`REQUIRED_SHARE` of the work
+    or of the time left without routes that serve them all."""
     if effort.out_of_time():
         return None, "time_limit"
-    patience = ITERATIONS_PER_STOP * len(model.node_clients)
-    stop = _Stop(effort.pyvrp_iterations(len(model.client_node)), patience, effort.deadline)
-    start = _pyvrp_start(model, initial)
-    result = pyvrp.solve(
-        model.data,
-        stop=stop,
-        seed=effort.seed,
-        display=False,
-        collect_stats=False,
-        initial_solution=start,
+    model = _pyvrp_model(problem, required=True)
+    if not model.client_node:
+        return [[] for _ in problem.vehicles], "work"
+    clients = len(model.client_node)
+    iterations = effort.pyvrp_iterations(clients)
+    give_up = (
+        int(iterations * REQUIRED_SHARE),
+        time.perf_counter() + effort.left_s() * REQUIRED_SHARE,
     )
+    result, stop = _pyvrp_search(model, effort, iterations, initial, give_up)
+    if stop.gave_up:
+        model = _pyvrp_model(problem, required=False)
+        rest = effort.share(1.0 - stop.done / iterations)
+        result, stop = _pyvrp_search(
+            model, rest, rest.pyvrp_iterations(clients, optional=True), initial
+        )
     routes: list[list[int]] = [[] for _ in problem.vehicles]
     taken = [0] * len(model.type_vans)
     for route in result.best.routes():
@@ -397,6 +476,27 @@ def _pyvrp_routes(
     if not result.is_feasible():  # the best it found, less the stops that break a rule
         routes = [_kept(problem, v, route) for v, route in enumerate(routes)]
     return routes, stop.ended
+
+
+def _pyvrp_search(
+    model: _PyvrpModel,
+    effort: Effort,
+    iterations: int,
+    initial: list[list[int]] | None,
+    give_up: tuple[int, float] | None = None,
+) -> tuple[pyvrp.Result, _Stop]:
+    """PyVRP's search on ``model`` for ``iterations`` under ``effort``'s deadline and seed."""
+    patience = ITERATIONS_PER_STOP * len(model.node_clients)
+    stop = _Stop(iterations, patience, effort.deadline, give_up)
+    result = pyvrp.solve(
+        model.data,
+        stop=stop,
+        seed=effort.seed,
+        display=False,
+        collect_stats=False,
+        initial_solution=_pyvrp_start(model, initial),
+    )
+    return result, stop
 
 
 def _kept(problem: RoutingInput, v: int, route: list[int]) -> list[int]:

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from app.examples import PLAN_EXAMPLE
+from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
 
 
 def long_plan(n_stops: int, time_limit_s: float, seed: int = 1) -> dict[str, Any]:
@@ -33,6 +33,30 @@ def long_plan(n_stops: int, time_limit_s: float, seed: int = 1) -> dict[str, Any
     body["work_s"] = time_limit_s
     body["time_limit_s"] = 2 * time_limit_s
     body["objective"] = "distance"
+    return body
+
+
+def big_fleet(n_stops: int, n_vans: int, time_limit_s: float, seed: int = 1) -> dict[str, Any]:
+    """A day of ``n_stops`` across Vienna, each with an hour's window between 07:00 and 17:00,
+    for ``n_vans`` vans; more work than ``time_limit_s`` allows, so the limit ends the search."""
+    rng = np.random.default_rng(seed)
+    body = copy.deepcopy(FLEET_PLAN_EXAMPLE)
+    van = body["vehicles"][1] | {"payload_kg": 1000, "shift_start": "06:00", "shift_end": "19:00"}
+    body["vehicles"] = [van | {"id": f"van-{k}"} for k in range(n_vans)]
+    opens = rng.integers(7, 17, n_stops)
+    body["stops"] = [
+        {
+            "id": f"S{i}",
+            "lat": 48.21 + rng.uniform(-0.06, 0.06),
+            "lon": 16.37 + rng.uniform(-0.1, 0.1),
+            "service_time_s": 120,
+            "door_open_s": 30,
+            "delivery_kg": 10,
+            "time_windows": [{"start": f"{hour:02d}:00", "end": f"{hour + 1:02d}:00"}],
+        }
+        for i, hour in enumerate(opens)
+    ]
+    body |= {"objective": "distance", "time_limit_s": time_limit_s, "work_s": 10 * time_limit_s}
     return body
 
 

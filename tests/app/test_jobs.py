@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import datetime as dt
 import itertools
 import os
 import signal
@@ -15,7 +16,7 @@ import pytest
 
 from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE, SCENARIOS_EXAMPLE
 from benchmarks.common import Server
-from tests.app.serving import alive, busiest_child, children, long_plan
+from tests.app.serving import alive, big_fleet, busiest_child, children, long_plan
 from tests.router_stub import DownRouter
 
 FAST = {
@@ -84,6 +85,29 @@ def test_a_fleet_plan_job_answers_what_the_endpoint_answers(server):
         for route in answer["routes"]:
             route["solver"].pop("runtime_s")
     assert done["result"] == direct
+
+
+def test_a_day_of_1000_stops_answers_within_its_time_limit(server):
+    # the bound: the time limit plus 10 % or 2 s, whichever is larger, on the API
+    # and as a job (its time running); the work is more than the limit allows
+    limit_s = 20.0
+    bound_s = limit_s + max(0.1 * limit_s, 2.0)
+    body = big_fleet(1000, 100, limit_s)
+    started = time.perf_counter()
+    direct = httpx.post(f"{server.url}/v1/fleet-plans", json=body, timeout=120)
+    waited_s = time.perf_counter() - started
+    assert direct.status_code == 200
+    answer = direct.json()
+    assert answer["solver"]["stopped_by"] == "time_limit"
+    assert sum(len(route["stops"]) for route in answer["routes"]) > 900
+    assert waited_s <= bound_s
+    submitted = submit(server.url, {"type": "fleet-plan", "request": body}).json()
+    job = wait_for(server.url, submitted["id"])
+    assert job["status"] == "succeeded"
+    started_at, finished_at = (
+        dt.datetime.fromisoformat(job[k]) for k in ("started_at", "finished_at")
+    )
+    assert (finished_at - started_at).total_seconds() <= bound_s
 
 
 @pytest.mark.parametrize(

@@ -120,3 +120,34 @@ def test_a_route_the_search_left_infeasible_keeps_the_stops_that_fit():
     # a shift that ends before the van is back from stop 3 (5 km, back at 10 min): stop 3 goes
     short = problem(positions, horizon=500)
     assert _kept(short, 0, [1, 3]) == [1]
+
+
+def test_a_van_too_small_for_every_stop_serves_the_most_it_can_nearest_first():
+    """Five 1 kg stops, a 3 kg van: no routes serve them all, so the search with every stop
+    required gives up and the one with stops optional serves three — the three nearest, the
+    cheapest three (at 1, 2 and 3 km: 6 km out and back)."""
+    positions = [5, 1, 4, 2, 3]
+    routes = problem(positions, demand=[1000] * 5, payload=3000)
+    outcome = solve_routes(routes, WORK)
+    assert outcome is not None and outcome.ended == "work"
+    assert sorted(outcome.routes[0]) == [2, 4, 5]
+    assert cost(outcome.routes, positions) == 6
+
+
+def test_pyvrp_is_given_costs_in_the_root_of_what_a_second_of_driving_costs():
+    """Metres against seconds (here 1,000 m per 60 s) are divided by the root of 1,000 / 60,
+    so PyVRP's penalties and neighbourhoods weigh time nearer to what they were tuned to; a
+    large fixed cost keeps its scale (and stays larger than any routes)."""
+    from core.routing.vrp import _pyvrp_model
+
+    positions = [1, 2, 4]
+    plain = problem(positions)
+    model = _pyvrp_model(plain, required=True)
+    per_s = 1000 / 60
+    np.testing.assert_array_equal(
+        np.asarray(model.data.distance_matrix(0)),
+        np.rint(line(positions) * 1000 / np.sqrt(per_s)),
+    )
+    fixed = _pyvrp_model(problem(positions, vans=3, fixed=10**6), required=True)
+    np.testing.assert_array_equal(np.asarray(fixed.data.distance_matrix(0)), line(positions) * 1000)
+    assert fixed.data.vehicle_type(0).fixed_cost > 4_000 * 4 * 3
