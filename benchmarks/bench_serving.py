@@ -17,7 +17,7 @@ import psycopg
 import redis
 
 from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
-from benchmarks.common import Server, print_table
+from benchmarks.common import Server, print_table, vienna_stops
 
 LOAD_S = 60.0
 CLIENTS = 8
@@ -27,17 +27,7 @@ POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
 def plan_with(n_stops: int, time_limit_s: float = 1.0, seed: int | None = None) -> dict:
     rng = np.random.default_rng(n_stops if seed is None else seed)
     body = copy.deepcopy(PLAN_EXAMPLE)
-    body["stops"] = [
-        {
-            "id": f"S{i}",
-            "lat": 48.21 + rng.uniform(-0.05, 0.05),
-            "lon": 16.37 + rng.uniform(-0.08, 0.08),
-            "service_time_s": 240,
-            "door_open_s": 90,
-            "delivery_kg": 400 / n_stops,
-        }
-        for i in range(n_stops)
-    ]
+    body["stops"] = vienna_stops(rng, n_stops, 240, 90, 400 / n_stops)
     body["time_limit_s"] = time_limit_s
     return body
 

@@ -197,3 +197,26 @@ def pyvrp_vrptw(
     result = solve(data, stop=MaxRuntime(budget_s), seed=1, display=False)
     served = result.best.num_clients() if result.is_feasible() else 0
     return result.best.distance() / scale, result.best.num_routes(), served
+
+
+def vienna_stops(
+    rng: np.random.Generator,
+    n_stops: int,
+    service_time_s: float,
+    door_open_s: float,
+    delivery_kg: float,
+    spread_deg: tuple[float, float] = (0.05, 0.08),
+) -> list[dict[str, Any]]:
+    """``n_stops`` stops (as JSON) scattered uniformly around Vienna's centre, up to
+    ``spread_deg`` degrees of latitude and longitude either way, named S0, S1, …"""
+    return [
+        {
+            "id": f"S{i}",
+            "lat": 48.21 + rng.uniform(-spread_deg[0], spread_deg[0]),
+            "lon": 16.37 + rng.uniform(-spread_deg[1], spread_deg[1]),
+            "service_time_s": service_time_s,
+            "door_open_s": door_open_s,
+            "delivery_kg": delivery_kg,
+        }
+        for i in range(n_stops)
+    ]

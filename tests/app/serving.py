@@ -12,23 +12,14 @@ from typing import Any
 import numpy as np
 
 from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
+from benchmarks.common import vienna_stops
 
 
 def long_plan(n_stops: int, time_limit_s: float, seed: int = 1) -> dict[str, Any]:
     """A round whose solve takes about ``time_limit_s`` of work (too many stops to prove)."""
     rng = np.random.default_rng(seed)
     body = copy.deepcopy(PLAN_EXAMPLE)
-    body["stops"] = [
-        {
-            "id": f"S{i}",
-            "lat": 48.21 + rng.uniform(-0.05, 0.05),
-            "lon": 16.37 + rng.uniform(-0.08, 0.08),
-            "service_time_s": 120,
-            "door_open_s": 30,
-            "delivery_kg": 1,
-        }
-        for i in range(n_stops)
-    ]
+    body["stops"] = vienna_stops(rng, n_stops, 120, 30, 1)
     # work of about the time asked for (the reference machine's), the limit well beyond it
     body["work_s"] = time_limit_s
     body["time_limit_s"] = 2 * time_limit_s
@@ -43,18 +34,11 @@ def big_fleet(n_stops: int, n_vans: int, time_limit_s: float, seed: int = 1) -> 
     body = copy.deepcopy(FLEET_PLAN_EXAMPLE)
     van = body["vehicles"][1] | {"payload_kg": 1000, "shift_start": "06:00", "shift_end": "19:00"}
     body["vehicles"] = [van | {"id": f"van-{k}"} for k in range(n_vans)]
+    stops = vienna_stops(rng, n_stops, 120, 30, 10, spread_deg=(0.06, 0.1))
     opens = rng.integers(7, 17, n_stops)
     body["stops"] = [
-        {
-            "id": f"S{i}",
-            "lat": 48.21 + rng.uniform(-0.06, 0.06),
-            "lon": 16.37 + rng.uniform(-0.1, 0.1),
-            "service_time_s": 120,
-            "door_open_s": 30,
-            "delivery_kg": 10,
-            "time_windows": [{"start": f"{hour:02d}:00", "end": f"{hour + 1:02d}:00"}],
-        }
-        for i, hour in enumerate(opens)
+        stop | {"time_windows": [{"start": f"{hour:02d}:00", "end": f"{hour + 1:02d}:00"}]}
+        for stop, hour in zip(stops, opens, strict=True)
     ]
     body |= {"objective": "distance", "time_limit_s": time_limit_s, "work_s": 10 * time_limit_s}
     return body
