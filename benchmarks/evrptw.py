@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.common import REFERENCE, print_table
-from core.routing.evrp import EvrpInstance, EvrpSolution, solve_evrptw
+from core.routing.effort import Effort
+from core.routing.evrp import EvrpInstance, EvrpSolution, VehicleKind, solve_evrptw
 
 FOLDER = REFERENCE / "evrptw"
 #: RoutingBlocks' ALNS (Klein & Schiffer 2023) at 60 s on this machine: (vehicles, distance).
@@ -65,6 +66,14 @@ def read(path: Path) -> Instance:
     distance = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
     column = [np.array([float(r[k]) for r in order]) for k in (4, 5, 6, 7)]
     customers = [k for k, r in enumerate(order) if r[1] == "c"]
+    vehicles = VehicleKind(
+        count=len(customers),
+        energy=values["r"] * distance,
+        battery=values["Q"],
+        initial=values["Q"],
+        capacity=values["C"],
+        due=float(column[2][0]),
+    )
     problem = EvrpInstance(
         distance=distance,
         duration=distance / values["v"],
@@ -74,10 +83,8 @@ def read(path: Path) -> Instance:
         demand=column[0],
         customers=customers,
         stations=[k for k, r in enumerate(order) if r[1] == "f"],
-        capacity=values["C"],
-        battery=values["Q"],
-        energy_per_distance=values["r"],
-        time_per_energy=values["g"],
+        charge_time=np.full(len(order), values["g"]),
+        kinds=[vehicles],
     )
     return Instance(path.name.split("_")[0], [r[0] for r in order], problem)
 
@@ -85,12 +92,13 @@ def read(path: Path) -> Instance:
 def check(instance: EvrpInstance, routes: list[list[tuple[int, float]]]) -> str | None:
     """What the routes break, by the rules alone (not the solver's code), or None."""
     seen: list[int] = []
+    vehicles = instance.kinds[0]
     for n, route in enumerate(routes):
         if route[0][0] != 0 or route[-1][0] != 0:
             return f"route {n} does not start and end at the depot"
-        battery, clock, load = instance.battery, instance.ready[0], 0.0
+        battery, clock, load = vehicles.battery, instance.ready[0], 0.0
         for (i, _), (j, charge) in itertools.pairwise(route):
-            battery -= instance.energy_per_distance * instance.distance[i, j]
+            battery -= vehicles.energy[i, j]
             clock += instance.duration[i, j]
             if battery < -TOLERANCE:
                 return f"route {n} runs empty before place {j}"
@@ -98,15 +106,15 @@ def check(instance: EvrpInstance, routes: list[list[tuple[int, float]]]) -> str 
                 return f"route {n} reaches place {j} after its window"
             clock = max(clock, instance.ready[j]) + instance.service[j]
             if j in instance.stations:
-                if battery + charge > instance.battery + TOLERANCE or charge < 0:
+                if battery + charge > vehicles.battery + TOLERANCE or charge < 0:
                     return f"route {n} charges {charge} at {j}, beyond the battery"
                 battery += charge
-                clock += instance.time_per_energy * charge
+                clock += instance.charge_time[j] * charge
             elif j != 0:
                 seen.append(j)
                 load += instance.demand[j]
-        if load > instance.capacity + TOLERANCE:
-            return f"route {n} carries {load}, more than {instance.capacity}"
+        if load > vehicles.capacity + TOLERANCE:
+            return f"route {n} carries {load}, more than {vehicles.capacity}"
     if sorted(seen) != sorted(instance.customers):
         return "not every customer is served exactly once"
     return None
@@ -115,9 +123,11 @@ def check(instance: EvrpInstance, routes: list[list[tuple[int, float]]]) -> str 
 def solved(instance: Instance, time_limit_s: float) -> dict[str, object]:
     """The instance solved, as one JSON object."""
     started = time.perf_counter()
-    solution: EvrpSolution = solve_evrptw(instance.problem, time_limit_s)
+    solution: EvrpSolution = solve_evrptw(
+        instance.problem, Effort.starting_now(time_limit_s, time_limit_s)
+    )
     runtime_s = time.perf_counter() - started
-    routes = [[(v.place, v.charge) for v in route] for route in solution.routes]
+    routes = [[(v.place, v.charge) for v in route.visits] for route in solution.routes]
     broken = check(instance.problem, routes)
     return {
         "instance": instance.name,

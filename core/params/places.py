@@ -175,7 +175,7 @@ _Table = list[Annotated[list[T], Field(max_length=MAX_STOPS + 1, fail_fast=True)
 
 class RoadMatrix(Params):
     """Distances and durations from the client's road router: depot first, then the stops in
-    request order."""
+    request order, then the chargers on the way (when the request has any)."""
 
     distances_m: _Table[Annotated[float, Field(ge=0, le=MAX_MATRIX_DISTANCE_M)]] = Field(
         ..., max_length=MAX_STOPS + 1, description="Road distance of each pair [m], 0–100,000 km."

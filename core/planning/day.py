@@ -225,7 +225,7 @@ def fleet_day(
     service_s[1 : len(base.stops) + 1] = [math.ceil(s.service_time_s) for s in base.stops]
     demand_g = np.zeros(solver_places, dtype=np.int64)
     demand_g[1 : len(base.stops) + 1] = payload_units_up([s.delivery_kg for s in base.stops])
-    solver_legs = _long_where_no_road(legs, finite)
+    solver_legs = long_where_no_road(legs, finite)
     kinds: dict[str, VanEstimates] = {}
     estimates = []
     for shift, start in zip(shifts, starts, strict=True):
@@ -254,7 +254,7 @@ def fleet_day(
     )
 
 
-def _long_where_no_road(legs: Legs, finite: NDArray[np.bool_]) -> Legs:
+def long_where_no_road(legs: Legs, finite: NDArray[np.bool_]) -> Legs:
     """The legs with the arcs that have no road made long (the solver never picks them)."""
     if finite.all():
         return legs

@@ -18,8 +18,11 @@ the full simulation of its day.
    simulation holds (:mod:`core.planning.repair`). A stop no van can serve is listed with its
    reason (:mod:`core.planning.explain`) — never a route reported feasible that the simulation
    says is not.
-4. With chargers (the depot's, or on the way), the stops left out for their battery are then
-   served by vans that charge where they can (:mod:`core.planning.fleet_charging`).
+4. With chargers (the depot's, or on the way) and stops left out for their battery, the
+   E-VRPTW search plans the fleet again from these routes with charges between stops, each
+   route verified by its simulation with its charges (:mod:`core.planning.fleet_charging`);
+   the fleet keeps whichever serves more stops (then fewer vans when asked, then the lower
+   objective).
 
 Every step is bounded by work, not by the clock (:mod:`core.routing.effort`): the solves by
 their share of the request's work, the verification by :data:`MAX_RESOLVES` re-solves, the
@@ -39,11 +42,12 @@ from core.exceptions import CoreError, InvalidParameterError, NoRouteError
 from core.params import Place
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import WeatherService, forecast_for
+from core.planning.charge_insertion import serve_with_charging
 from core.planning.day import FleetDay, VanShift, fleet_day, leg_roads
 from core.planning.estimates import LearnedTimes
 from core.planning.explain import explain
 from core.planning.feasibility import Feasibility
-from core.planning.fleet_charging import serve_with_charging
+from core.planning.fleet_charging import charging_routes, measure
 from core.planning.model import (
     FleetProblem,
     FleetResult,
@@ -64,7 +68,6 @@ from core.planning.start_state import START_ID, check_start, check_start_id, und
 from core.planning.timeline import client_legs_too_fast, drive_time_s
 from core.planning.verify import Failure, route_failure, traced_seconds
 from core.routing.effort import Effort, SearchEnd, combined
-from core.routing.geo import build_legs
 from core.routing.roads import RememberingRouter, RoadRouter
 from core.routing.vrp import solve_routes
 
@@ -73,6 +76,10 @@ from core.routing.vrp import solve_routes
 FIRST_SOLVE_SHARE = 0.8
 RESOLVE_SHARE = 0.05
 MAX_RESOLVES = 4
+#: With chargers: the first solve's share, and the charging search's.
+CHARGING_FIRST_SHARE = 0.25
+CHARGING_SHARE = 0.6
+
 #: A tightened energy budget is cut this much below the simulated need, so the next
 #: solution does not land on the edge again.
 TIGHTEN_MARGIN = 0.98
@@ -248,8 +255,6 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
                 f"{field}.time",
             )
         shifts.append(VanShift(vehicle.id, under_way(round_problem), now or ends[0], ends[1]))
-    if problem.matrix is not None:
-        build_legs(problem.places, problem.matrix)
     return shifts, timezone_name
 
 
@@ -427,13 +432,25 @@ def _simulated(
     return out
 
 
+def _unassigned(
+    rules: Feasibility, routes: list[list[int]], left_out: dict[int, Failure]
+) -> list[Unassigned]:
+    """Each stop no route serves, with why (:func:`core.planning.explain.explain`)."""
+    served = {node for route in routes for node in route}
+    return [
+        explain(rules, node, left_out.get(node), routes)
+        for node in rules.day.stop_nodes
+        if node not in served
+    ]
+
+
 def search(
     day: FleetDay, minimize_vehicles: bool, effort: Effort, charging: bool = False
 ) -> Routed:
     """Solve and verify until every route holds or :data:`MAX_RESOLVES` re-solves are spent,
     each solve its share of ``effort``'s work; ``minimize_vehicles``: fewer vans first, then
-    the objective. With ``charging``, the stops then left out for their battery are served by
-    vans that charge (:mod:`core.planning.fleet_charging`)."""
+    the objective. With ``charging`` and stops then left out for their battery, the fleet is
+    planned again with charges between stops (:mod:`core.planning.fleet_charging`)."""
     times = LearnedTimes(day.duration_s, day.finite, day.horizon_s)
     calibrate(day, times)
     budgets = [
@@ -454,7 +471,7 @@ def search(
             ends.append("time_limit")
             break
         rules = Feasibility(day, times.matrix(), budgets)
-        share = FIRST_SOLVE_SHARE if not rounds else RESOLVE_SHARE
+        share = RESOLVE_SHARE if rounds else CHARGING_FIRST_SHARE if charging else FIRST_SOLVE_SHARE
         outcome = solve_routes(
             routing_input(rules, minimize_vehicles),
             effort.share(share).keeping(reserve_s),
@@ -490,17 +507,25 @@ def search(
             results[v] = repaired.result
     rules = Feasibility(day, times.matrix(), budgets)
     left_out |= _given_to_idle(day, rules, routes, results)
-    served = {node for route in routes for node in route}
-    unassigned = [
-        explain(rules, node, left_out.get(node), routes)
-        for node in day.stop_nodes
-        if node not in served
-    ]
-    if charging:
-        routes, results, unassigned, charged = serve_with_charging(
+    unassigned = _unassigned(rules, routes, left_out)
+    if charging and any(u.reason == "battery" for u in unassigned):
+        charged = charging_routes(
+            day,
+            times.matrix(),
+            routes,
+            minimize_vehicles,
+            effort.share(CHARGING_SHARE).keeping(reserve_s / 2),
+        )
+        ends.append(charged.ended)
+        if measure(day, charged.routes, charged.results, minimize_vehicles) < measure(
+            day, routes, results, minimize_vehicles
+        ):
+            routes, results = charged.routes, charged.results
+            unassigned = _unassigned(rules, routes, charged.removed)
+        routes, results, unassigned, inserted = serve_with_charging(
             day, routes, results, unassigned, minimize_vehicles, effort
         )
-        ends.append(charged)
+        ends.append(inserted)
     for v in day.vans:  # a van under way with no stop left drives back to the depot
         if day.starts[v] and not routes[v]:
             results[v] = day.simulate(v, [])

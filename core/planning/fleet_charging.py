@@ -1,41 +1,72 @@
-"""Charging in a fleet's day: the stops the search left out because no battery lasted are
-served by vans that charge between stops — at the depot's charger or on the way — and a
-charge point busy with another van of the fleet is not free.
+"""Charging in a fleet's day: the E-VRPTW search (:mod:`core.routing.evrp`) plans the routes,
+the chargers between their stops and what to charge at each, on the planning layer's
+estimates; every route is then verified by the full simulation of its day with its charges
+fitted, the charge points booked across the fleet, and repaired where the simulation refuses.
 
-After the search (:mod:`core.planning.fleet`) every route holds without charging. Each stop
-left out for its battery is then tried in the vans' routes at its cheapest places by distance
-on the objective (:data:`POSITIONS_TRIED` per van) and in a van not driving yet: the route
-simulated with the charges it needs (:func:`core.planning.recharge.with_charges`, from the
-charges it had: every later window and the shift's end kept, the charge points free only
-between the other vans' charges). The first that holds — fewer charges by the estimates
-first, then what the objective gains, a van already driving before a new one when the fleet
-is to be small — takes the stop; its charges are booked on their charge points. A stop
-no van can take so is left out as before, its detail saying that charging did not help (or,
-when the work's tries, :data:`TRIES_PER_S` per reference second, ran out first, that it was
-not tried everywhere).
+1. **The search's instance** (:func:`charging_instance`): the day's places, the chargers on
+   the way and the depot's charger (a place of its own in the search: a van comes back to
+   charge), each arc's cost on the objective, its driving time (the times the simulation
+   taught the search) and, per kind of van, its energy (traction by the arc's grade for the
+   van's mass, the standing loads by its duration, each stop's service and door openings at
+   its origin: :mod:`core.planning.estimates`); each van kind's battery between its reserve
+   and full, what it holds at departure, its payload, its shift and where it sets off; each
+   charger's charge time per joule (the van's charging curve at the charger's power, reserve
+   to 80 %) and its plug-in time; each stop's window (the first opening to the last close).
+2. **The search** starts from the routes the fleet's search found without charging (the
+   stops left out inserted where they cost least) and serves every stop it can, then fewest
+   vans (when asked), then the objective.
+3. **Verification**: each route is simulated with its charges fitted to what the simulation
+   says each stretch takes (:func:`core.planning.recharge.with_charges`), the charge points
+   free only between the other vans' charges (:class:`Bookings`). A route the simulation
+   refuses loses the stop it names, else the costliest, until it holds
+   (:func:`core.planning.repair.repair`).
+
+The fleet keeps whichever serves more stops — then fewer vans when asked, then the lower
+objective — of the routes without charging and these.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 from core.params import ChargePoint
-from core.planning.day import FleetDay
-from core.planning.model import DEPOT_CHARGER_ID, PlanResult, Unassigned
-from core.planning.recharge import Busy, visits_of
+from core.physics.battery import JOULES_PER_KWH
+from core.physics.charging import WATTS_PER_KW, charge_curve
+from core.planning.day import FleetDay, long_where_no_road
+from core.planning.estimates import cost_matrix, energy_matrix_j
+from core.planning.model import DEPOT_CHARGER_ID, PlanResult
+from core.planning.recharge import Busy
+from core.planning.repair import Repaired, repair
 from core.planning.scene import charge_points
 from core.planning.timeline import ChargeVisit
-from core.planning.verify import route_failure
-from core.routing.effort import Effort, SearchEnd
-from core.routing.vrp import trips_tidied
+from core.planning.verify import Failure, route_failure
+from core.routing.effort import Effort, SearchEnd, combined
+from core.routing.evrp import (
+    EvrpInstance,
+    EvrpSolution,
+    VehicleKind,
+    solve_evrptw,
+)
+from core.routing.geo import Legs
+from core.routing.units import payload_units_down
 
-#: Places in each van's route a left-out stop is tried at, cheapest by distance first.
-POSITIONS_TRIED = 3
-#: Tries per reference second of work: each simulates a van's day with its charges fitted
-#: (0.05–0.1 s on the reference machine for days of 20–40 stops).
-TRIES_PER_S = 10.0
+#: State of charge the charge time per joule is taken up to (the curve's constant part).
+CHARGE_TIME_SOC = 0.8
+#: The share of each van's battery (and of its charge at departure) the search plans with:
+#: the estimates do not see every draw of the simulation (the weather through the day, the
+#: standing loads while waiting), and a charge cannot make up a stretch beyond a full battery.
+BATTERY_MARGIN = 0.9
+#: Searches at most (the first, then again after routes the simulation refused for their
+#: battery), the first's share of the work, and how many times what a route fell below its
+#: reserve its kind of van's battery is made smaller after.
+CHARGING_ROUNDS = 3
+FIRST_SHARE = 0.7
+TIGHTEN_MARGIN = 1.2
 
 
 @dataclass
@@ -83,137 +114,277 @@ def _full(
     return full
 
 
-def serve_with_charging(
-    day: FleetDay,
-    routes: list[list[int]],
-    results: dict[int, PlanResult],
-    unassigned: list[Unassigned],
-    minimize_vehicles: bool,
-    effort: Effort,
-) -> tuple[list[list[int]], dict[int, PlanResult], list[Unassigned], SearchEnd]:
-    """The fleet's routes (stops per van), their simulations and the stops left out, with the
-    stops left out for their battery served by vans that charge where they can; the rest of
-    ``unassigned`` as it was; and how the tries ended: ``effort``'s work is
-    :data:`TRIES_PER_S` tries per second of it, over the candidate places
-    (:data:`POSITIONS_TRIED` per van) of the stops in turn; its deadline may cut them short."""
+@dataclass(frozen=True)
+class ChargingInstance:
+    """The search's instance of a fleet's day, and how to read its answer: the product's
+    place of each of the search's places (the depot's charger is the depot), the vans of each
+    kind, and each charger's plug-in time [s] and power [kW]."""
+
+    instance: EvrpInstance
+    place_of: list[int]
+    vans_of: list[list[int]]
+    points: dict[int, ChargePoint]
+
+
+def charging_instance(
+    day: FleetDay, times_s: np.ndarray, minimize_vehicles: bool
+) -> ChargingInstance:
+    """The E-VRPTW instance of ``day`` (module docstring, item 1); ``times_s`` the driving
+    times the simulation taught the search (the day's solver places)."""
+    problem = day.shifts[0].problem
     places = day.scene.places
-    bookings = Bookings(charge_points(day.shifts[0].problem, places))
-    place_of = {place.id: k for k, place in enumerate(places)}
-    served: set[int] = set()
-    untried: set[int] = set()  # the tries ran out before every place of the stop was tried
-    ended: SearchEnd = "work"
-    tries = max(int(effort.work_s * TRIES_PER_S), 1)
-    for stop in unassigned:
-        if stop.reason != "battery":
-            continue
-        node = place_of[stop.id]
-        for insertion in _candidates(day, routes, node, minimize_vehicles):
-            if effort.out_of_time():
-                ended = "time_limit"
-            if tries <= 0 or ended == "time_limit":
-                untried.add(node)
-                break
-            tries -= 1
-            v = insertion.v
-            shift = day.shifts[v]
-            order, charges = _with_stop(day, results.get(v), insertion)
-            result = day.charged(v, order, charges, bookings.busy(shift.id))
-            if route_failure(shift.id, shift.problem, places, result, shift.end, True) is None:
-                routes[v], results[v] = insertion.route, result
-                bookings.book(shift.id, place_of, result)
-                served.add(node)
-                break
-    left = [
-        replace(u, detail=f"{u.detail}; {_charging_said(place_of[u.id] in untried)}")
-        if u.reason == "battery"
-        else u
-        for u in unassigned
-        if place_of[u.id] not in served
-    ]
-    return routes, results, left, ended
-
-
-def _charging_said(untried: bool) -> str:
-    """What charging did for a stop left out for its battery."""
-    if untried:
-        return (
-            "the search for a van to serve it with charging ended before it was tried at "
-            "every place (a larger work_s tries more)"
-        )
-    return (
-        "charging did not let a van serve it either (no charger within reach, or no time "
-        "for the charge)"
+    points = charge_points(problem, places)
+    every = day.scene.legs
+    legs = long_where_no_road(every, np.isfinite(every.duration_s) & np.isfinite(every.distance_m))
+    place_of = list(range(len(places))) + ([0] if 0 in points else [])
+    at = np.array(place_of)
+    arcs = np.ix_(at, at)
+    n = day.n
+    duration = legs.duration_s.copy()
+    taught = day.finite & (day.duration_s > 0)
+    ratio = float(times_s[taught].sum() / max(day.duration_s[taught].sum(), 1e-9))
+    duration *= ratio if taught.any() else 1.0
+    duration[:n, :n] = np.where(day.finite, times_s, duration[:n, :n])
+    arc_cost, unit_value, _ = cost_matrix(problem, legs, day.shifts[0].start)
+    stations = [q for q, p in enumerate(place_of) if p in points and (q > 0)]
+    ready, due, service = _windows(day, len(place_of), stations, place_of, points)
+    kinds, vans_of = _kinds(day, legs, arcs)
+    charge_time = np.zeros(len(place_of))
+    for q in stations:
+        charge_time[q] = _seconds_per_joule(day, points[place_of[q]])
+    instance = EvrpInstance(
+        distance=arc_cost[arcs].astype(float) * unit_value,
+        duration=duration[arcs],
+        ready=ready,
+        due=due,
+        service=service,
+        demand=np.concatenate([day.demand_g, np.zeros(len(place_of) - n)]).astype(float),
+        customers=[k for k in day.stop_nodes if k not in day.unreachable],
+        stations=stations,
+        charge_time=charge_time,
+        kinds=kinds,
+        fewest_vehicles=minimize_vehicles,
     )
+    return ChargingInstance(instance, place_of, vans_of, points)
+
+
+def _windows(
+    day: FleetDay,
+    size: int,
+    stations: Sequence[int],
+    place_of: Sequence[int],
+    points: dict[int, ChargePoint],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each place's window (a stop's first opening to its last close; the depot's the day)
+    and service [s]: a stop's, a charger's plug-in and out."""
+    ready, due, service = np.zeros(size), np.full(size, float(day.horizon_s)), np.zeros(size)
+    for k, windows in enumerate(day.windows_s):
+        if windows:
+            ready[k], due[k] = windows[0][0], windows[-1][1]
+    service[: day.n] = day.service_s
+    for q in stations:
+        service[q] = points[place_of[q]].plug_minutes * 60.0
+    return ready, due, service
+
+
+def _kinds(
+    day: FleetDay, legs: Legs, arcs: tuple[np.ndarray, ...]
+) -> tuple[list[VehicleKind], list[list[int]]]:
+    """The fleet's kinds — vans alike in estimates, shift and start — and their vans."""
+    groups: dict[tuple[int, tuple[float, float], int], list[int]] = {}
+    for v in day.vans:
+        groups.setdefault((id(day.estimates[v]), day.shift_s[v], day.starts[v]), []).append(v)
+    kinds = []
+    for vans in groups.values():
+        v = vans[0]
+        shift = day.shifts[v]
+        problem = shift.problem
+        estimates = day.estimates[v]
+        energy = energy_matrix_j(problem, legs, shift.start)
+        energy[: day.n, : day.n] = estimates.energy_j
+        battery = problem.van.battery
+        window = battery.initial_soc - battery.min_soc
+        kinds.append(
+            VehicleKind(
+                count=len(vans),
+                energy=energy[arcs],
+                battery=estimates.budget_j * (1.0 - battery.min_soc) / window * BATTERY_MARGIN,
+                initial=estimates.budget_j * BATTERY_MARGIN if shift.battery_enforced else math.inf,
+                capacity=float(payload_units_down(problem.van.payload_kg)),
+                start=day.starts[v],
+                ready=day.shift_s[v][0],
+                due=day.shift_s[v][1],
+            )
+        )
+    return kinds, list(groups.values())
+
+
+def _seconds_per_joule(day: FleetDay, point: ChargePoint) -> float:
+    """Time to charge a joule at ``point`` [s/J]: the first van's charging curve at the
+    point's power, from its reserve to :data:`CHARGE_TIME_SOC`."""
+    battery = day.shifts[0].problem.van.battery
+    curve = charge_curve(battery, point.power_kw * WATTS_PER_KW)
+    top = max(CHARGE_TIME_SOC, battery.min_soc + 0.05)
+    joules = (top - battery.min_soc) * battery.usable_capacity_kwh * JOULES_PER_KWH
+    return curve.time_s(battery.min_soc, top) / joules
 
 
 @dataclass(frozen=True)
-class _Insertion:
-    """Van ``v``'s ``route`` (stops, a 0 a return to reload) with ``placed`` — the stop, and
-    a return to reload before or after it — at position ``k`` of its route before."""
+class Charging:
+    """The fleet's routes (stops per van) with charging, their simulations, the stops the
+    verification took out with why, and how the search ended."""
 
-    v: int
-    route: list[int]
-    k: int
-    placed: list[int]
-
-
-def _with_stop(
-    day: FleetDay, driven: PlanResult | None, insertion: _Insertion
-) -> tuple[list[int], dict[int, ChargeVisit]]:
-    """The order the van drives its longer route in, keeping the chargers and charges of
-    what it drove before (``driven``)."""
-    v = insertion.v
-    if driven is None:
-        return day.order(v, insertion.route), {}
-    problem = day.shifts[v].problem
-    order, charges = visits_of(problem, day.scene.places, driven, day.starts[v])
-    after = 0  # where the route's place before the insertion is in the order
-    for place in insertion.route[: insertion.k]:
-        after = order.index(place, after + 1)
-    order = [*order[: after + 1], *insertion.placed, *order[after + 1 :]]
-    shift = len(insertion.placed)
-    return order, {q + shift * (q > after): c for q, c in charges.items()}
+    routes: list[list[int]]
+    results: dict[int, PlanResult]
+    removed: dict[int, Failure]
+    ended: SearchEnd
 
 
-def _placings(route: list[int], node: int, under_way: bool) -> list[tuple[int, list[int]]]:
-    """Where and how ``node`` may join ``route``: at each position, alone, or with a return
-    to reload before or after it (when a trip would get too heavy for the van); never a
-    return at an end (but the first of a van ``under_way``) or beside another."""
-    out = []
-    for k in range(len(route) + 1):
-        for placed in ([node], [0, node], [node, 0]):
-            longer = [*route[:k], *placed, *route[k:]]
-            if trips_tidied(longer, under_way) == longer:
-                out.append((k, placed))
-    return out
+def measure(
+    day: FleetDay, routes: list[list[int]], results: dict[int, PlanResult], fewest_vans: bool
+) -> tuple[int, int, float]:
+    """Stops left out, vans driving (when fewer vans come first) and the objective's value
+    of the simulated days: the lower the better."""
+    served = sum(1 for route in routes for node in route if node)
+    objective = day.shifts[0].problem.objective
+    value = sum(
+        r.distance_m if objective == "distance" else r.duration_s if objective == "duration"
+        else r.energy_kwh["total"]
+        for v, r in results.items()
+        if routes[v]
+    )  # fmt: skip
+    vans = sum(1 for route in routes if route) if fewest_vans else 0
+    return -served, vans, value
 
 
-def _candidates(
-    day: FleetDay, routes: list[list[int]], node: int, minimize_vehicles: bool
-) -> list[_Insertion]:
-    """Each van's route with ``node`` at its cheapest places on the objective (the van
-    carrying every trip), and ``node`` alone for a van not driving, best first: fewer charges
-    by the estimates (the energy beyond the battery, in batteries), then what the objective
-    gains; the vans not driving after the others when the fleet is to be small."""
-    options: list[tuple[bool, int, float, int, _Insertion]] = []
-    idle: set[tuple[int, tuple[float, float]]] = set()
-    for v, route in enumerate(routes):
-        estimates = day.estimates[v]
-        kind = (id(estimates), day.shift_s[v])
-        if not route and kind in idle:
-            continue  # a van like one tried already
-        if not route:
-            idle.add(kind)
-        before = estimates.route_cost(route)
-        tried: list[tuple[float, int, _Insertion]] = []
-        for k, placed in _placings(route, node, day.starts[v] != 0):
-            longer = [*route[:k], *placed, *route[k:]]
-            if day.carries(v, longer):
-                extra = estimates.route_cost(longer) - before
-                tried.append((extra, len(tried), _Insertion(v, longer, k, placed)))
-        for extra, _, insertion in sorted(tried)[:POSITIONS_TRIED]:
-            energy_j = estimates.route_energy_j(insertion.route)
-            charges = max(math.ceil(energy_j / max(estimates.budget_j, 1.0) - 1.0), 0)
-            options.append((minimize_vehicles and not route, charges, extra, v, insertion))
-    options.sort(key=lambda o: o[:4])
-    return [insertion for *_, insertion in options]
+def charging_routes(
+    day: FleetDay,
+    times_s: np.ndarray,
+    routes: list[list[int]],
+    minimize_vehicles: bool,
+    effort: Effort,
+) -> Charging:
+    """The fleet's routes with charging (module docstring), from ``routes`` (stops per van,
+    a 0 a return to reload) found without. A route whose simulation runs below its reserve
+    makes its kind of van's battery (and its charge at departure) smaller in the search by what
+    the simulation fell below the reserve, :data:`TIGHTEN_MARGIN` times, and the search starts
+    again from ``routes`` (which hold without charging; the routes it found may not hold with
+    the smaller battery even when charged), at most
+    :data:`CHARGING_ROUNDS` times; the best verified routes are kept."""
+    charging = charging_instance(day, times_s, minimize_vehicles)
+    kind_of = {v: k for k, vans in enumerate(charging.vans_of) for v in vans}
+    initial = [(kind_of[v], [p for p in route if p]) for v, route in enumerate(routes) if route]
+    best: Charging | None = None
+    ends: list[SearchEnd] = []
+    for round_ in range(CHARGING_ROUNDS):
+        share = FIRST_SHARE if not round_ else (1.0 - FIRST_SHARE) / (CHARGING_ROUNDS - 1)
+        solution = solve_evrptw(charging.instance, effort.share(share), initial)
+        ends.append(solution.ended)
+        verified, short = _verified(day, charging, solution)
+        verified = replace(verified, ended=combined(ends))
+        if best is None or _ranked(day, verified, minimize_vehicles) < _ranked(
+            day, best, minimize_vehicles
+        ):
+            best = verified
+        if not short or solution.ended == "time_limit":
+            break
+        charging = replace(charging, instance=_tightened(charging.instance, short))
+    assert best is not None
+    return replace(best, ended=combined(ends))
+
+
+def _ranked(day: FleetDay, charging: Charging, fewest_vans: bool) -> tuple[int, int, float]:
+    return measure(day, charging.routes, charging.results, fewest_vans)
+
+
+def _tightened(instance: EvrpInstance, short_j: dict[int, float]) -> EvrpInstance:
+    """Each kind's battery and charge at departure less what its simulated routes fell below
+    the reserve [J], :data:`TIGHTEN_MARGIN` times."""
+    kinds = [
+        replace(
+            kind,
+            battery=kind.battery - short_j[k] * TIGHTEN_MARGIN,
+            initial=kind.initial - short_j[k] * TIGHTEN_MARGIN,
+        )
+        if k in short_j
+        else kind
+        for k, kind in enumerate(instance.kinds)
+    ]
+    return replace(instance, kinds=kinds)
+
+
+def _verified(
+    day: FleetDay, charging: ChargingInstance, solution: EvrpSolution
+) -> tuple[Charging, dict[int, float]]:
+    """Each route of ``solution`` given to a van of its kind, simulated with its charges
+    fitted and the charge points booked, repaired until it holds; and by kind, the most a
+    route fell below its reserve for its battery [J]."""
+    places = day.scene.places
+    bookings = Bookings(charging.points)
+    index = {place.id: k for k, place in enumerate(places)}
+    routes: list[list[int]] = [[] for _ in day.vans]
+    results: dict[int, PlanResult] = {}
+    removed: dict[int, Failure] = {}
+    short: dict[int, float] = {}
+    free = [list(vans) for vans in charging.vans_of]
+    for route in solution.routes:
+        v = free[route.kind].pop(0)
+        order = [charging.place_of[visit.place] for visit in route.visits]
+        charges = {
+            q: _visit(charging.points[order[q]], visit.charge, charging.instance, visit.place)
+            for q, visit in enumerate(route.visits)
+            if 0 < q < len(order) - 1 and visit.place in charging.instance.stations
+        }
+        repaired, first = _held(day, v, order, charges, bookings)
+        if first is not None and first.battery.margin_kwh < 0:
+            below_j = -first.battery.margin_kwh * JOULES_PER_KWH
+            short[route.kind] = max(short.get(route.kind, 0.0), below_j)
+        routes[v] = repaired.route
+        removed |= repaired.removed
+        if repaired.result is not None:
+            results[v] = repaired.result
+            bookings.book(day.shifts[v].id, index, repaired.result)
+    return Charging(routes, results, removed, solution.ended), short
+
+
+def _visit(point: ChargePoint, charge_j: float, instance: EvrpInstance, q: int) -> ChargeVisit:
+    return ChargeVisit(
+        instance.service[q], charge_j * float(instance.charge_time[q]), point.power_kw
+    )
+
+
+def _held(
+    day: FleetDay,
+    v: int,
+    order: list[int],
+    charges: dict[int, ChargeVisit],
+    bookings: Bookings,
+) -> tuple[Repaired, PlanResult | None]:
+    """Van ``v`` driving ``order`` (its chargers among the stops) with ``charges`` fitted —
+    else its stops with the charges the planner places itself
+    (:func:`core.planning.recharge.with_charges`) —, stops taken out until its simulation
+    holds (the chargers stay where they are); and its first simulation when neither held."""
+    shift = day.shifts[v]
+    busy = bookings.busy(shift.id)
+    stops = [place for q, place in enumerate(order) if 0 < q < len(order) - 1 and q not in charges]
+
+    def simulate(kept: list[int]) -> PlanResult:
+        keep = set(kept)
+        ends = (0, len(order) - 1)
+        positions = [q for q in range(len(order)) if q in charges or q in ends or order[q] in keep]
+        renumbered = {n: charges[q] for n, q in enumerate(positions) if q in charges}
+        return day.charged(v, [order[q] for q in positions], renumbered, busy)
+
+    def check(_kept: list[int], result: PlanResult) -> Failure | None:
+        return route_failure(shift.id, shift.problem, day.scene.places, result, shift.end, True)
+
+    result = simulate(stops)
+    failure = check(stops, result)
+    if failure is None:
+        return Repaired(stops, result, {}), None
+    # the planner's own charges (a charge point the others take, a stretch the estimates
+    # made too long), before any stop goes
+    own = day.charged(v, day.order(v, stops), {}, busy)
+    if check(stops, own) is None:
+        return Repaired(stops, own, {}), None
+    return repair(stops, failure, simulate, check, day.estimates[v]), result

@@ -13,7 +13,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, Discriminator, Field, Tag, ValidationInfo, field_validator
 
-from core.exceptions import InvalidParameterError, InvalidStopsError
+from core.exceptions import InvalidStopsError
 from core.params import (
     BRANCH_TAG,
     MAX_CHARGERS,
@@ -38,7 +38,7 @@ from core.params import (
 from core.physics.battery import BatteryVerdict
 from core.physics.weather import DayWeather, WeatherSource
 from core.routing.effort import Effort, SearchEnd
-from core.routing.geo import DistanceSource
+from core.routing.geo import DistanceSource, build_legs
 from core.routing.tsp import SolverStatus
 
 #: How the answers name the depot's charger.
@@ -389,15 +389,17 @@ def check_stop_ids(depot: Depot, stops: Sequence[Stop], chargers: Sequence[Charg
 
 
 def check_places(problem: RoundFields) -> None:
-    """Ids of the stops and the chargers their own (:func:`check_stop_ids`), and chargers
-    only with the planner's legs (a client's matrix has no rows for them)."""
+    """Ids of the stops and the chargers their own (:func:`check_stop_ids`), and a client's
+    matrix with a row and a column for each (:func:`matrix_places`)."""
     check_stop_ids(problem.depot, problem.stops, problem.chargers)
-    if problem.chargers and problem.matrix is not None:
-        raise InvalidParameterError(
-            "a client matrix has no rows for the chargers on the way: leave out matrix (the "
-            "planner estimates the legs or asks its router) or chargers",
-            "chargers",
-        )
+    if problem.matrix is not None:
+        build_legs(matrix_places(problem), problem.matrix)
+
+
+def matrix_places(problem: RoundFields) -> list[Place]:
+    """The places a client's matrix has rows for, in its order: the depot, the stops, then the
+    chargers on the way."""
+    return [*problem.places, *problem.chargers]
 
 
 def place_field(index: int) -> str:

@@ -49,7 +49,7 @@ from core.planning.scene import (
 from core.planning.start_state import START_ID, check_start, path_tour, under_way
 from core.planning.timeline import client_legs_too_fast, windows_after
 from core.routing.effort import Effort, SearchEnd, combined
-from core.routing.geo import Legs, build_legs
+from core.routing.geo import Legs
 from core.routing.roads import LegRoute, RememberingRouter, RoadRouter
 from core.routing.tsp import Tour, solve_path, solve_tour
 
@@ -273,8 +273,6 @@ def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
     check_places(problem)
     check_payload(problem)
     start, timezone_name = round_start(problem)
-    if problem.matrix is not None:
-        build_legs(problem.places, problem.matrix)
     return check_start(problem, start.tzinfo) or start, timezone_name
 
 

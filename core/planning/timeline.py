@@ -59,6 +59,17 @@ def next_window(arrival_s: float, windows_s: Windows) -> tuple[float, float] | N
     return next(((a, b) for a, b in windows_s if arrival_s <= b), None)
 
 
+def charge_window(
+    arrival_s: float, windows_s: Windows, needed_s: float
+) -> tuple[float, float] | None:
+    """The window a van arriving at a charger at ``arrival_s`` charges in: the first with room
+    for the ``needed_s`` it stands there (it waits for it: a point another van takes before
+    the charge is done is no place to start it), else the first that has not closed (the
+    charge cut short at its close); :func:`next_window`'s rule otherwise."""
+    roomy = (w for w in windows_s if w[1] - max(w[0], arrival_s) >= needed_s)
+    return next(roomy, None) or next_window(arrival_s, windows_s)
+
+
 def seconds_after(date: dt.date, clock: dt.time, reference: dt.datetime) -> float:
     """The local ``clock`` time on ``date`` in ``reference``'s zone, in seconds after
     ``reference`` (elapsed time: daylight saving counted)."""
@@ -413,13 +424,14 @@ class _Builder:
     def charge(
         self, position: int, visit: ChargeVisit, reload: tuple[float, float] | None = None
     ) -> None:
-        """Stand at a charger (place ``position`` of the order): wait for it to open, plug in,
-        charge for ``visit.charge_s`` (until it closes at the latest), unplug. A charger
+        """Stand at a charger (place ``position`` of the order): wait for it to open with room
+        for the charge (:func:`charge_window`), plug in, charge for ``visit.charge_s`` (until
+        it closes at the latest), unplug. A charger
         closed for the rest of the day charges nothing. ``reload`` (its duration [s] and the
         payload [kg]): the van is reloaded meanwhile, and stands at least that long."""
         plug = math.ceil(visit.plug_s / 2 / PLAN_DT_S)
         arrival = self.clock
-        hours = next_window(arrival * PLAN_DT_S, visit.open_s)
+        hours = charge_window(arrival * PLAN_DT_S, visit.open_s, visit.plug_s + visit.charge_s)
         wait, charge = 0, math.ceil(visit.charge_s / PLAN_DT_S)
         if hours is None:
             charge = 0

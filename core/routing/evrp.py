@@ -1,57 +1,66 @@
 """Vehicle routing with recharging stations and time windows, partial recharge (E-VRPTW-PR of
 Schneider, Stenger & Goeke, *Transportation Science* 48 (2014) 500; Keskin & Çatay,
-*Transportation Research C* 65 (2016) 111): fewest vehicles, then distance.
+*Transportation Research C* 65 (2016) 111): every customer served if the fleet can, then
+fewest vehicles (when asked), then least cost.
 
 A vehicle's battery falls by the energy of each arc it drives and rises at a station by what
-it charges there, at a time per unit of energy; it never falls below empty nor rises above
+it charges there, at a time per unit of energy; it never falls below its floor nor rises above
 its capacity. Customers are served once inside their windows (waiting allowed) within the
-load capacity.
+load capacity. The fleet is of kinds (:class:`VehicleKind`): how many, where each sets off
+and when, by when it is back, its battery and the energy of each arc for it.
 
-1. **Routes of customers.** PyVRP solves the routing problem of the customers alone, with
-   windows and load, its arc times lengthened by :data:`CHARGE_TIME_SHARE` of the time the
-   arc's energy takes to charge (charging is time a route must find room for).
-2. **Stations on a route** (:func:`route_with_stations`, Numba): for a fixed order of
-   customers, the stations between them and how much to charge at each, by labels over the
-   route's gaps: at most one station per gap among the :data:`STATIONS_PER_GAP` with the
-   least detour; a charge gives what the way to the next station (or the depot) takes — the
-   least, so the least time; labels of cost, time and battery on arrival, kept when no other
-   is as good on all three (at most :data:`LABELS_PER_NODE`). The least distance that keeps
-   every window and the battery wins — or, with a penalty per unit of time late, the least
-   distance plus the penalised lateness (Vidal et al.'s time warp, *Computers & OR* 40
-   (2013) 475).
-3. **Search** until the deadline (Numba evaluates, Python searches): the customers of a route
-   that cannot be charged are inserted where they cost least; then, in turn, a vehicle
-   less — the route with the fewest customers emptied into the others, late where it must
-   be, then ruin and recreate around the late customers on distance plus
-   :data:`LATE_PENALTY` per unit late until none is (else undone) — and the distance: ruin
-   and recreate (a few nearby customers out, each back where it costs least, only into
-   routes that hold one of its :data:`NEIGHBOURS` nearest), kept when no worse (a route it
-   empties is a vehicle less too).
+1. **Routes of customers**: given (a planner's routes without charging), or PyVRP's routes of
+   the customers alone, with windows and load, its arc times lengthened by
+   :data:`CHARGE_TIME_SHARE` of the time the arc's energy takes to charge (charging is time a
+   route must find room for).
+2. **Stations on a route** (:mod:`core.routing.stations`): for a fixed order of customers, the
+   stations between them and how much to charge at each, by labels.
+3. **Search** on work — the route evaluations, by their size (:data:`EVALUATION_S`,
+   :data:`SQUARE_S`) — capped by the deadline (Numba evaluates, Python searches): the
+   customers of a route that cannot be charged are inserted where they cost least (left out
+   when no vehicle can take them); then, in turn, a vehicle less — the route with the fewest
+   customers emptied into the others, late where it must be, then ruin and recreate around
+   the late customers on cost plus :data:`LATE_PENALTY` per unit late until none is (else
+   undone) — and the cost: ruin and recreate (a few nearby customers out, each back where it
+   costs least, only into routes that hold one of its :data:`NEIGHBOURS` nearest; the
+   customers left out tried again), kept when no worse (a route it empties is a vehicle less
+   too).
 """
 
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import pyvrp
-from numba import njit
-from numpy.typing import NDArray
-from pyvrp.stop import MaxRuntime
+from pyvrp.stop import MaxIterations, MaxRuntime, MultipleCriteria
 
 from core.arrays import FloatArray
+from core.routing.effort import Effort, SearchEnd
+from core.routing.stations import (
+    NO_ROUTE,
+    Charged,
+    RouteFacts,
+    Visit,
+    route_with_stations,
+    station_candidates,
+)
 
 #: Share of the charging time of an arc's energy that step 1 adds to the arc's time.
 CHARGE_TIME_SHARE = 0.5
-#: Stations considered on each gap between two places of a route, least detour first.
-STATIONS_PER_GAP = 4
-#: Labels kept at each station (or the start) of a route.
-LABELS_PER_NODE = 6
-#: Share of the budget for step 1.
+#: Share of the work for step 1.
 ROUTING_SHARE = 0.15
-#: PyVRP's integers: distances and times this many per unit.
+#: The search's work [reference s]: this much per route evaluated (with its stations) and per
+#: square of its places (the labels compare each station of a gap with the places after it),
+#: fitted on Schneider et al.'s instances on the reference machine (c101: 12 routes of about
+#: 8 customers, 15,500 evaluations a second; r201 and rc201: 4 routes of 25, 3,200).
+EVALUATION_S = 2.8e-5
+SQUARE_S = 2.4e-7
+#: And per ruin-and-recreate move, beyond its evaluations (the remembered ones cost little
+#: but are not free: a small instance whose routes are all remembered still ends).
+MOVE_S = 1e-4
+#: PyVRP's integers: costs and times this many per unit.
 _SCALE = 1000
 #: Customers taken out and put back by one ruin-and-recreate move.
 RUIN_SIZE = 14
@@ -61,40 +70,56 @@ NEIGHBOURS = 15
 #: Route evaluations remembered (then forgotten all at once).
 MEMO_SIZE = 1_000_000
 #: Emptying a route into the others: the penalty per unit of time late (lateness first, then
-#: distance), and the share of the time left one attempt may take.
+#: cost), and the share of the work left one attempt may take.
 LATE_PENALTY = 1000.0
 ELIMINATION_SHARE = 0.1
-#: The most of the search's time all attempts to empty a route may take together: a fleet
-#: that cannot lose a van leaves the rest to the distance.
+#: The most of the search's work all attempts to empty a route may take together: a fleet
+#: that cannot lose a vehicle leaves the rest to the cost.
 ELIMINATION_BUDGET = 0.2
-#: Ruin-and-recreate moves on the distance between two attempts to empty a route; the most
-#: a move may worsen the distance at first [share]; rounds between attempts at a vehicle less
-#: once every route has had its turn.
+#: Ruin-and-recreate moves on the cost between two attempts to empty a route; the most a
+#: move may worsen the cost at first [share]; rounds between attempts at a vehicle less once
+#: every route has had its turn.
 DISTANCE_MOVES = 100
 START_THRESHOLD = 0.02
 ELIMINATION_EVERY = 10
 
 
 @dataclass(frozen=True)
+class VehicleKind:
+    """Vehicles alike: how many, the energy each arc takes them, their battery (the most it
+    holds above its floor, and what it holds at departure), their load capacity, the place
+    they set off from, their earliest departure and latest return to the depot."""
+
+    count: int
+    energy: FloatArray
+    battery: float
+    initial: float
+    capacity: float
+    start: int = 0
+    ready: float = 0.0
+    due: float = math.inf
+
+
+@dataclass(frozen=True)
 class EvrpInstance:
-    """The places (index 0 the depot, then the customers, then the stations) and the fleet.
+    """The places (index 0 the depot, then any others: customers, stations, the vehicles'
+    positions) and the fleet.
 
     Attributes
     ----------
     distance, duration
-        Distance and travel time of each arc.
+        Cost (the objective) and travel time of each arc.
     ready, due, service, demand
-        Each place's window, service time and demand (0 at the depot and the stations).
+        Each place's window, service time (at a station: the time to plug in and out) and
+        demand (0 at the depot and the stations).
     customers, stations
         The customers' and the stations' indices.
-    capacity
-        Load capacity of a vehicle.
-    battery
-        Battery capacity (energy).
-    energy_per_distance
-        Energy an arc takes per unit of its distance.
-    time_per_energy
-        Time to charge one unit of energy.
+    charge_time
+        Time to charge one unit of energy at each place (finite; read at the stations).
+    kinds
+        The fleet.
+    fewest_vehicles
+        Fewest vehicles before the least cost.
     """
 
     distance: FloatArray
@@ -105,52 +130,64 @@ class EvrpInstance:
     demand: FloatArray
     customers: list[int]
     stations: list[int]
-    capacity: float
-    battery: float
-    energy_per_distance: float
-    time_per_energy: float
+    charge_time: FloatArray
+    kinds: list[VehicleKind]
+    fewest_vehicles: bool = True
 
 
 @dataclass(frozen=True)
-class Visit:
-    """A place of a route and the energy charged there (0 but at stations)."""
+class EvrpRoute:
+    """A vehicle of kind ``kind`` driving ``visits`` (start first, depot last, stations with
+    their charges)."""
 
-    place: int
-    charge: float
+    kind: int
+    visits: list[Visit]
 
 
 @dataclass(frozen=True)
 class EvrpSolution:
-    """The routes (depot first and last, stations included) and their total distance."""
+    """The routes, their total cost, the customers no vehicle could take and how the search
+    ended."""
 
-    routes: list[list[Visit]]
+    routes: list[EvrpRoute]
     distance: float
+    left_out: list[int]
+    ended: SearchEnd = "work"
 
     @property
     def vehicles(self) -> int:
         return len(self.routes)
 
 
-def solve_evrptw(instance: EvrpInstance, time_limit_s: float, seed: int = 0) -> EvrpSolution:
-    """Fewest vehicles, then least distance, within ``time_limit_s`` [s]."""
-    deadline = time.perf_counter() + time_limit_s
-    search = _Search(instance, np.random.default_rng(seed))
-    routes = _customer_routes(instance, time_limit_s * ROUTING_SHARE)
-    search.start(routes)
-    search.improve(deadline)
-    return search.solution()
+Routes = list[tuple[int, list[int]]]
 
 
-def _customer_routes(instance: EvrpInstance, time_limit_s: float) -> list[list[int]]:
-    """Step 1: PyVRP's routes of the customers, charging time partly in the arcs."""
+def solve_evrptw(
+    instance: EvrpInstance, effort: Effort, initial: Routes | None = None
+) -> EvrpSolution:
+    """Every customer served if the fleet can, then fewest vehicles (``fewest_vehicles``),
+    then the least cost, from ``initial`` routes (kind, customers) or PyVRP's (step 1, when
+    every vehicle sets off from the depot), in ``effort``'s work."""
+    search = _Search(instance, np.random.default_rng(effort.seed))
+    if initial is None:
+        initial = _customer_routes(instance, effort.share(ROUTING_SHARE))
+    search.start(initial)
+    ended = search.improve(effort.work_s * (1.0 - ROUTING_SHARE), effort)
+    return search.solution(ended)
+
+
+def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
+    """Step 1: PyVRP's routes of the customers, charging time partly in the arcs (the first
+    kind's energy), every kind a vehicle type of its own."""
+    if any(kind.start != 0 for kind in instance.kinds):
+        raise ValueError("routes of customers for vehicles under way must be given")
     customers = instance.customers
     nodes = [0, *customers]
-    n = len(nodes)
-    distance = np.rint(instance.distance[np.ix_(nodes, nodes)] * _SCALE).astype(np.int64)
-    charge = instance.energy_per_distance * instance.time_per_energy * CHARGE_TIME_SHARE
-    arc_time = (
-        instance.duration[np.ix_(nodes, nodes)] + charge * instance.distance[np.ix_(nodes, nodes)]
-    )
+    arcs = np.ix_(nodes, nodes)
+    distance = np.rint(instance.distance[arcs] * _SCALE).astype(np.int64)
+    stations = instance.stations or [0]
+    charge = float(np.mean(instance.charge_time[stations])) * CHARGE_TIME_SHARE
+    arc_time = instance.duration[arcs] + charge * instance.kinds[0].energy[arcs]
     duration = np.rint(arc_time * _SCALE).astype(np.int64)
     clients = [
         pyvrp.Client(
@@ -162,80 +199,121 @@ def _customer_routes(instance: EvrpInstance, time_limit_s: float) -> list[list[i
         )
         for k, c in enumerate(customers, start=1)
     ]
-    horizon = round(instance.due[0] * _SCALE)
+    horizon = float(instance.due[0])
+    types = [
+        pyvrp.VehicleType(
+            num_available=min(kind.count, len(customers)),
+            capacity=[math.floor(kind.capacity)],
+            fixed_cost=int(distance.sum()) if instance.fewest_vehicles else 0,
+            tw_early=round(kind.ready * _SCALE),
+            tw_late=round(min(kind.due, horizon) * _SCALE),
+        )
+        for kind in instance.kinds
+    ]
     data = pyvrp.ProblemData(
-        [pyvrp.Location(0.0, 0.0) for _ in range(n)],
+        [pyvrp.Location(0.0, 0.0) for _ in nodes],
         clients,
-        [pyvrp.Depot(location=0, tw_early=0, tw_late=horizon)],
-        [
-            pyvrp.VehicleType(
-                num_available=len(customers),
-                capacity=[round(instance.capacity)],
-                fixed_cost=int(distance.sum()),
-                tw_early=0,
-                tw_late=horizon,
-            )
-        ],
+        [pyvrp.Depot(location=0, tw_early=0, tw_late=round(horizon * _SCALE))],
+        types,
         [distance],  # type: ignore[list-item]  # PyVRP's stubs name ndarray[int]
         [duration],
     )
-    result = pyvrp.solve(data, stop=MaxRuntime(max(time_limit_s, 0.1)), seed=0, display=False)
+    stop = MultipleCriteria(
+        [
+            MaxIterations(effort.pyvrp_iterations(len(customers))),
+            MaxRuntime(max(effort.left_s(), 0.01)),
+        ]
+    )
+    result = pyvrp.solve(data, stop=stop, seed=effort.seed, display=False)
     return [
-        [customers[visit.idx] for visit in route.schedule() if visit.is_client()]
+        (route.vehicle_type(), [customers[v.idx] for v in route.schedule() if v.is_client()])
         for route in result.best.routes()
     ]
 
 
 class _Search:
-    """The routes of customers and what each costs with its stations (memoised), at the
+    """The routes (kind, customers) and what each costs with its stations (memoised), at the
     current ``penalty`` per unit of time late (infinite: routes must keep their windows)."""
 
     def __init__(self, instance: EvrpInstance, rng: np.random.Generator) -> None:
         self.instance = instance
         self.rng = rng
-        self.routes: list[list[int]] = []
+        self.routes: Routes = []
+        self.left: list[int] = []
         self.penalty = math.inf
-        self.best: tuple[tuple[int, float], list[list[int]]] | None = None
-        self.memo: dict[tuple[float, tuple[int, ...]], Charged] = {}
+        self.evaluations = 0
+        self.moves = 0
+        self.squares = 0
+        self.best: tuple[tuple[int, int, float], Routes, list[int]] | None = None
+        self.memo: dict[tuple[float, int, tuple[int, ...]], Charged] = {}
         inst = instance
-        stations = np.array(inst.stations, dtype=np.int64)
-        self.candidates = _station_candidates(inst.distance, stations)
-        self.nearest = np.argsort(inst.distance[np.ix_(inst.customers, inst.customers)], axis=1)
+        self.facts = [_facts(inst, kind) for kind in inst.kinds]
+        self.candidates = station_candidates(inst.distance, np.array(inst.stations, np.int64))
+        self.nearest = np.argsort(
+            inst.distance[np.ix_(inst.customers, inst.customers)], axis=1, kind="stable"
+        )
         self.near = {
             c: {inst.customers[k] for k in self.nearest[n][1 : NEIGHBOURS + 1]}
             for n, c in enumerate(inst.customers)
         }
 
-    def charged(self, route: list[int]) -> Charged:
-        key = (self.penalty, tuple(route))
+    def charged(self, kind: int, route: list[int]) -> Charged:
+        key = (self.penalty, kind, tuple(route))
         if key not in self.memo:
             if len(self.memo) > MEMO_SIZE:
                 self.memo.clear()
-            self.memo[key] = route_with_stations(
-                self.instance, route, self.candidates, self.penalty
-            )
+            self.memo[key] = self._evaluated(kind, route)
         return self.memo[key]
 
-    def cost(self, route: list[int]) -> float:
-        """The route's distance with its stations and its penalised lateness; infinite when
-        it cannot hold."""
-        return self.charged(route).cost(self.penalty)
+    def _evaluated(self, kind: int, route: list[int]) -> Charged:
+        vehicle = self.instance.kinds[kind]
+        seq = np.array([vehicle.start, *route, 0], dtype=np.int64)
+        self.evaluations += 1
+        self.squares += seq.size**2
+        load = float(self.instance.demand[seq].sum())
+        if load > vehicle.capacity + 1e-9:
+            return NO_ROUTE
+        cost, warp, gaps, charges = route_with_stations(
+            self.facts[kind], seq, self.candidates, self.penalty
+        )
+        if not math.isfinite(cost):
+            return NO_ROUTE
+        return Charged(float(cost), float(warp), load, seq, gaps, charges)
+
+    def cost(self, kind: int, route: list[int]) -> float:
+        """The route's cost with its stations and its penalised lateness; infinite when it
+        cannot hold."""
+        return self.charged(kind, route).cost(self.penalty)
 
     def late(self) -> float:
-        return sum(self.charged(r).warp for r in self.routes)
+        return sum(self.charged(k, r).warp for k, r in self.routes)
 
-    def total(self) -> tuple[int, float]:
-        return len(self.routes), sum(self.cost(r) for r in self.routes)
+    def holds(self) -> bool:
+        return all(math.isfinite(self.cost(k, r)) for k, r in self.routes)
 
-    def start(self, routes: list[list[int]]) -> None:
-        """The routes that hold; the customers of those that do not, inserted where best."""
+    def total(self) -> tuple[int, int, float]:
+        """Customers left out, vehicles (when they count), cost."""
+        vehicles = len(self.routes) if self.instance.fewest_vehicles else 0
+        return len(self.left), vehicles, sum(self.cost(k, r) for k, r in self.routes)
+
+    def spare(self, kind: int) -> bool:
+        """Whether a vehicle of ``kind`` is not driving yet."""
+        used = sum(1 for k, _ in self.routes if k == kind)
+        return used < self.instance.kinds[kind].count
+
+    def start(self, routes: Routes) -> None:
+        """The routes that hold (within each kind's count); the customers of those that do
+        not, inserted where best."""
         left: list[int] = []
-        for route in routes:
-            route = list(route)
-            while route and math.isinf(self.cost(route)):
-                # the customer whose leaving makes the route hold at the least distance, else
+        for kind, customers in routes:
+            route = list(customers)
+            if not self.spare(kind):
+                left.extend(route)
+                continue
+            while route and math.isinf(self.cost(kind, route)):
+                # the customer whose leaving makes the route hold at the least cost, else
                 # the one farthest out
-                shorter = [(self.cost([x for x in route if x != c]), c) for c in route]
+                shorter = [(self.cost(kind, [x for x in route if x != c]), c) for c in route]
                 fits = [sc for sc in shorter if math.isfinite(sc[0])]
                 if fits:
                     worst = min(fits)[1]
@@ -244,456 +322,196 @@ class _Search:
                 route.remove(worst)
                 left.append(worst)
             if route:
-                self.routes.append(route)
-        for customer in left:
-            self.insert(customer)
+                self.routes.append((kind, route))
+        served = {c for _, r in self.routes for c in r} | set(left)
+        left += [c for c in self.instance.customers if c not in served]
+        self.left = [c for c in left if not self.insert(c)]
 
     def insert(self, customer: int, allow_new: bool = True) -> bool:
-        """Put ``customer`` where it adds the least cost (a new route when none takes it and
-        ``allow_new``).
+        """Put ``customer`` where it adds the least cost (a new route of a spare vehicle when
+        none takes it and ``allow_new``); False when nowhere.
 
         Positions are tried by a lower bound on what they add — the detour of the customer
         alone less what the route's stations and lateness cost now (a route with the customer
-        drives at least its plain distance) — and the search stops at the first bound no
-        better than the best found: the same answer as trying them all, at a fraction of the
-        route evaluations."""
-        dist = self.instance.distance
-        demand = self.instance.demand[customer]
-        near = self.near[customer]
-        bounds: list[tuple[float, int, int]] = []
-        for r, route in enumerate(self.routes):
-            if self.charged(route).load + demand > self.instance.capacity:
-                continue
-            if not near.intersection(route):
-                continue  # no neighbour of it there: it would cost more than where they are
-            seq = np.array([0, *route, 0])
-            arcs = dist[seq[:-1], seq[1:]]
-            detour = dist[seq[:-1], customer] + dist[customer, seq[1:]] - arcs
-            spare = self.cost(route) - float(arcs.sum())  # stations and lateness
-            bounds.extend((float(d) - spare, r, k) for k, d in enumerate(detour))
-        bounds.sort()
+        drives at least its plain cost) — and the search stops at the first bound no better
+        than the best found: the same answer as trying them all, at a fraction of the route
+        evaluations."""
         best: tuple[float, list[int]] | None = None
         at = -1
-        for bound, r, k in bounds:
+        for bound, r, k in self._bounds(customer):
             if best is not None and bound >= best[0] - 1e-9:
                 break
-            route = self.routes[r]
+            kind, route = self.routes[r]
             longer = [*route[:k], customer, *route[k:]]
-            extra = self.cost(longer) - self.cost(route)
+            extra = self.cost(kind, longer) - self.cost(kind, route)
             if best is None or extra < best[0]:
                 best, at = (extra, longer), r
         if best is not None and math.isfinite(best[0]):
-            self.routes[at] = best[1]
+            self.routes[at] = (self.routes[at][0], best[1])
             return True
-        if allow_new:
-            self.routes.append([customer])
-            return True
-        return False
+        if not allow_new:
+            return False
+        alone = [
+            (self.cost(kind, [customer]), kind)
+            for kind in range(len(self.instance.kinds))
+            if self.spare(kind)
+        ]
+        fits = [ck for ck in alone if math.isfinite(ck[0])]
+        if not fits:
+            return False
+        self.routes.append((min(fits)[1], [customer]))
+        return True
 
-    def improve(self, deadline: float) -> None:
-        """Step 3 until ``deadline``: :data:`DISTANCE_MOVES` ruin-and-recreate moves, each
-        kept when it is at most a threshold worse (falling from :data:`START_THRESHOLD` to
-        nothing as the time runs out: threshold accepting, Dueck & Scheuer 1990), then an
-        attempt at a vehicle less (in at most :data:`ELIMINATION_SHARE` of the time left; the
-        next smallest route after each that fails, and once every routes' turn is over, only
-        every :data:`ELIMINATION_EVERY` rounds; all in at most :data:`ELIMINATION_BUDGET` of the
-        time), and again. The best routes seen are kept."""
-        began = time.perf_counter()
+    def _bounds(self, customer: int) -> list[tuple[float, int, int]]:
+        """Each place in the routes ``customer`` may join (load, a neighbour there) with a
+        lower bound on what it adds, least first."""
+        inst = self.instance
+        demand = inst.demand[customer]
+        near = self.near[customer]
+        bounds: list[tuple[float, int, int]] = []
+        for r, (kind, route) in enumerate(self.routes):
+            if self.charged(kind, route).load + demand > inst.kinds[kind].capacity:
+                continue
+            if not near.intersection(route):
+                continue  # no neighbour of it there: it would cost more than where they are
+            seq = np.array([inst.kinds[kind].start, *route, 0])
+            arcs = inst.distance[seq[:-1], seq[1:]]
+            detour = inst.distance[seq[:-1], customer] + inst.distance[customer, seq[1:]] - arcs
+            spare = self.cost(kind, route) - float(arcs.sum())  # stations and lateness
+            bounds.extend((float(d) - spare, r, k) for k, d in enumerate(detour))
+        bounds.sort()
+        return bounds
+
+    @property
+    def spent_s(self) -> float:
+        """The work done [reference s]: route evaluations by their size, and moves."""
+        return EVALUATION_S * self.evaluations + SQUARE_S * self.squares + MOVE_S * self.moves
+
+    def improve(self, work_s: float, effort: Effort) -> SearchEnd:
+        """Step 3 for ``work_s`` [reference s], capped by ``effort``'s deadline:
+        :data:`DISTANCE_MOVES` ruin-and-recreate moves, each kept when it is at most a
+        threshold worse (falling from :data:`START_THRESHOLD` to nothing as the work runs
+        out: threshold accepting, Dueck & Scheuer 1990), then an attempt at a vehicle less (in
+        at most :data:`ELIMINATION_SHARE` of the work left; the next smallest route after
+        each that fails, and once every route's turn is over, only every
+        :data:`ELIMINATION_EVERY` rounds; all in at most :data:`ELIMINATION_BUDGET` of the
+        work), and again. The best routes seen are kept."""
         self.keep_if_best()
+        end = self.spent_s + work_s
         nth = rounds = 0
-        eliminating_s = 0.0
-        while time.perf_counter() < deadline:
+        eliminating = 0.0
+        while self.spent_s < end:
             rounds += 1
             for _ in range(DISTANCE_MOVES):
-                now = time.perf_counter()
-                if now >= deadline:
-                    return
-                share = (deadline - now) / max(deadline - began, 1e-9)
-                self._ruin_and_recreate(START_THRESHOLD * share)
+                if self.spent_s >= end:
+                    return "work"
+                if effort.out_of_time():
+                    return "time_limit"
+                self._ruin_and_recreate(START_THRESHOLD * (end - self.spent_s) / work_s)
                 self.keep_if_best()
+            if not self.instance.fewest_vehicles:
+                continue
             if nth >= len(self.routes) and rounds % ELIMINATION_EVERY:
                 continue
-            now = time.perf_counter()
-            budget_s = ELIMINATION_BUDGET * (deadline - began) - eliminating_s
-            if budget_s <= 0:
+            room = min(
+                (end - self.spent_s) * ELIMINATION_SHARE, ELIMINATION_BUDGET * work_s - eliminating
+            )
+            if room <= 0:
                 continue
-            until = now + min((deadline - now) * ELIMINATION_SHARE, budget_s)
-            eliminated = self._eliminate(until, nth)
-            eliminating_s += time.perf_counter() - now
+            before = self.spent_s
+            eliminated = self._eliminate(self.spent_s + room, nth, effort)
+            eliminating += self.spent_s - before
             if eliminated:
                 nth = 0
                 self.keep_if_best()
             else:
                 nth += 1
+        return "work"
 
     def keep_if_best(self) -> None:
         total = self.total()
         if self.best is None or total < self.best[0]:
-            self.best = (total, [list(r) for r in self.routes])
+            self.best = (total, [(k, list(r)) for k, r in self.routes], list(self.left))
 
-    def _eliminate(self, until: float, nth: int) -> bool:
+    def _saved(self) -> tuple[Routes, list[int]]:
+        return [(k, list(r)) for k, r in self.routes], list(self.left)
+
+    def _eliminate(self, until: float, nth: int, effort: Effort) -> bool:
         """Empty the ``nth`` smallest route into the others, late at first, and search on the
-        penalised lateness until none is late or ``until``; False (and nothing changed) when
-        lateness is left."""
+        penalised lateness until none is late or the work done is ``until``; False (and nothing
+        changed) when lateness is left."""
         if len(self.routes) < 2:
             return False
-        saved = [list(r) for r in self.routes]
-        order = sorted(range(len(self.routes)), key=lambda r: len(self.routes[r]))
-        out = self.routes.pop(order[nth % len(order)])
+        saved = self._saved()
+        order = sorted(range(len(self.routes)), key=lambda r: len(self.routes[r][1]))
+        _, out = self.routes.pop(order[nth % len(order)])
         self.penalty = LATE_PENALTY
         if not all(self.insert(c, allow_new=False) for c in out):
-            self.routes, self.penalty = saved, math.inf
+            (self.routes, self.left), self.penalty = saved, math.inf
             return False
-        while self.late() > 1e-9 and time.perf_counter() < until:
+        while self.late() > 1e-9 and self.spent_s < until and not effort.out_of_time():
             self._ruin_and_recreate(0.0, late_first=True)
         holds = self.late() <= 1e-9
         self.penalty = math.inf
-        if not holds or any(math.isinf(self.cost(r)) for r in self.routes):
-            self.routes = saved
+        if not holds or not self.holds():
+            self.routes, self.left = saved
             return False
         return True
 
     def _ruin_and_recreate(self, threshold: float, late_first: bool = False) -> None:
         """A few nearby customers out (around a late one with ``late_first``), each back
-        where it costs least; kept with no vehicle more and a cost at most ``threshold``
-        (a share) worse."""
-        saved = [list(r) for r in self.routes]
+        where it costs least, then those left out; kept with no more left out, no vehicle more
+        and a cost at most ``threshold`` (a share) worse."""
+        self.moves += 1
+        saved = self._saved()
         before = self.total()
         customers = self.instance.customers
         seed = int(self.rng.integers(len(customers)))
         if late_first:
-            late = [r for r in self.routes if self.charged(r).warp > 0]
+            late = [r for k, r in self.routes if self.charged(k, r).warp > 0]
             if late:
                 pick = late[int(self.rng.integers(len(late)))]
                 seed = customers.index(pick[int(self.rng.integers(len(pick)))])
         size = int(self.rng.integers(2, RUIN_SIZE + 1))
-        taken = {customers[k] for k in self.nearest[seed][:size]}
-        self.routes = [[c for c in r if c not in taken] for r in self.routes]
-        self.routes = [r for r in self.routes if r]
+        taken = {customers[k] for k in self.nearest[seed][:size]} - set(self.left)
+        self.routes = [(k, [c for c in r if c not in taken]) for k, r in self.routes]
+        self.routes = [(k, r) for k, r in self.routes if r]
         placed = all(
             self.insert(int(c), allow_new=not late_first)
             for c in self.rng.permutation(sorted(taken))
         )
+        if not late_first:
+            self.left = [c for c in self.left if not self.insert(c)]
         after = self.total()
-        worse = after[0] > before[0] or (
-            after[0] == before[0] and after[1] > before[1] * (1.0 + threshold) + 1e-9
+        worse = after[:2] > before[:2] or (
+            after[:2] == before[:2] and after[2] > before[2] * (1.0 + threshold) + 1e-9
         )
-        if not placed or worse or any(math.isinf(self.cost(r)) for r in self.routes):
-            self.routes = saved
+        if not placed or worse or not self.holds():
+            self.routes, self.left = saved
 
-    def solution(self) -> EvrpSolution:
+    def solution(self, ended: SearchEnd) -> EvrpSolution:
         self.penalty = math.inf
         if self.best is not None and self.best[0] < self.total():
-            self.routes = self.best[1]
-        routes = [self.charged(r).visits for r in self.routes]
-        return EvrpSolution(routes, sum(self.charged(r).distance for r in self.routes))
+            _, self.routes, self.left = self.best
+        routes = [EvrpRoute(k, self.charged(k, r).visits) for k, r in self.routes]
+        distance = sum(self.charged(k, r).distance for k, r in self.routes)
+        return EvrpSolution(routes, distance, sorted(self.left), ended)
 
 
-def _station_candidates(distance: FloatArray, stations: NDArray[np.int64]) -> NDArray[np.int64]:
-    """For each arc, the :data:`STATIONS_PER_GAP` stations of least detour."""
-    detour = distance[:, stations][:, None, :] + distance[stations, :].T[None, :, :]
-    best = np.argsort(detour, axis=2)[:, :, :STATIONS_PER_GAP]
-    return stations[best]
-
-
-@dataclass(frozen=True)
-class Charged:
-    """A route with its stations: its distance, the time it is late in all (``warp``, only
-    with a finite penalty), its load, and per gap between two places of ``seq`` (depot,
-    customers, depot) the station visited (−1: none) and the energy charged there."""
-
-    distance: float
-    warp: float
-    load: float = 0.0
-    seq: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    gaps: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    charges: FloatArray = field(default_factory=lambda: np.zeros(0))
-
-    def cost(self, penalty: float) -> float:
-        return self.distance + (penalty * self.warp if self.warp > 0 else 0.0)
-
-    @property
-    def visits(self) -> list[Visit]:
-        """The places in order, depot first and last, stations included (built only for
-        the answer: the search compares costs)."""
-        visits = [Visit(int(self.seq[0]), 0.0)] if self.seq.size else []
-        for p in range(self.seq.size - 1):
-            if self.gaps[p] >= 0:
-                visits.append(Visit(int(self.gaps[p]), float(self.charges[p])))
-            visits.append(Visit(int(self.seq[p + 1]), 0.0))
-        return visits
-
-
-NO_ROUTE = Charged(math.inf, 0.0)
-
-
-def route_with_stations(
-    instance: EvrpInstance,
-    route: list[int],
-    candidates: NDArray[np.int64],
-    penalty: float = math.inf,
-) -> Charged:
-    """``route`` (customers in order) with the stations and charges it needs at the least
-    distance, plus ``penalty`` per unit of time late (a place reached after its window is
-    served at its close, the lateness counted: Vidal et al.'s time warp; infinite: never
-    late); :data:`NO_ROUTE` when no choice keeps the load and the battery (and the windows)."""
-    inst = instance
-    seq = np.array([0, *route, 0], dtype=np.int64)
-    load = float(inst.demand[seq].sum())
-    if load > inst.capacity + 1e-9:
-        return NO_ROUTE
-    distance, warp, gaps, charges = _labels(
-        seq,
-        inst.distance,
-        inst.duration,
-        inst.ready,
-        inst.due,
-        inst.service,
-        candidates,
-        inst.battery,
-        inst.energy_per_distance,
-        inst.time_per_energy,
-        penalty,
+def _facts(instance: EvrpInstance, kind: VehicleKind) -> RouteFacts:
+    """What routes of ``kind`` are evaluated on: its energies and battery, its departure,
+    its latest return as the depot's close."""
+    due = instance.due.copy()
+    due[0] = min(due[0], kind.due)
+    return RouteFacts(
+        cost=instance.distance,
+        duration=instance.duration,
+        energy=kind.energy,
+        ready=instance.ready,
+        due=due,
+        service=instance.service,
+        charge_time=instance.charge_time,
+        battery=kind.battery,
+        initial=kind.initial,
+        start_time=kind.ready,
     )
-    if not math.isfinite(distance):
-        return NO_ROUTE
-    return Charged(float(distance), float(warp), load, seq, gaps, charges)
-
-
-@njit(cache=True)
-def _labels(
-    seq: NDArray[np.int64],
-    dist: FloatArray,
-    dur: FloatArray,
-    ready: FloatArray,
-    due: FloatArray,
-    service: FloatArray,
-    cand: NDArray[np.int64],
-    battery: float,
-    rate: float,
-    time_per_energy: float,
-    penalty: float,
-) -> tuple[float, float, NDArray[np.int64], FloatArray]:
-    """Labels over the route's charge points — the start (node 0), then station k of gap p
-    (between ``seq[p]`` and ``seq[p + 1]``, node ``1 + p·K + k``): the least distance (plus
-    the penalised lateness) to the end, its lateness and, per gap, the station (−1: none) and
-    what it charges. A label's charge is decided by the next charge point: what the way there
-    takes beyond the battery on arrival."""
-    m = seq.size - 1
-    k_max = cand.shape[2]
-    nodes = 1 + m * k_max
-    cap = LABELS_PER_NODE
-    lab_c = np.full((nodes, cap), np.inf)  # distance + penalty × warp
-    lab_d = np.zeros((nodes, cap))
-    lab_w = np.zeros((nodes, cap))
-    lab_t = np.zeros((nodes, cap))
-    lab_b = np.zeros((nodes, cap))
-    lab_prev = np.full((nodes, cap), -1, dtype=np.int64)
-    lab_prev_l = np.full((nodes, cap), -1, dtype=np.int64)
-    lab_x = np.zeros((nodes, cap))
-    count = np.zeros(nodes, dtype=np.int64)
-    lab_c[0, 0] = 0.0
-    lab_t[0, 0] = ready[seq[0]]
-    lab_b[0, 0] = battery
-    count[0] = 1
-    hard = not np.isfinite(penalty)
-    best_c, best_d, best_w, best_u, best_l, best_x = np.inf, 0.0, 0.0, -1, -1, 0.0
-    for u in range(nodes):
-        if count[u] == 0:
-            continue
-        if u == 0:
-            here, first = seq[0], 1
-        else:
-            gap = (u - 1) // k_max
-            here, first = cand[seq[gap], seq[gap + 1], (u - 1) % k_max], gap + 1
-        for li in range(count[u]):
-            d0, w0, t0, b0 = lab_d[u, li], lab_w[u, li], lab_t[u, li], lab_b[u, li]
-            if u == 0:  # a station straight from the depot, before the first customer
-                for k in range(k_max):
-                    s = cand[seq[0], seq[1], k]
-                    to_s = rate * dist[here, s]
-                    arrive = t0 + dur[here, s]
-                    late = max(arrive - due[seq[0]], 0.0)
-                    if to_s <= b0 + 1e-9 and not (hard and late > 1e-9):
-                        _add_label(
-                            1 + k,
-                            dist[here, s],
-                            late,
-                            min(arrive, due[seq[0]]),
-                            b0 - to_s,
-                            penalty,
-                            u,
-                            li,
-                            0.0,
-                            lab_c,
-                            lab_d,
-                            lab_w,
-                            lab_t,
-                            lab_b,
-                            lab_prev,
-                            lab_prev_l,
-                            lab_x,
-                            count,
-                            cap,
-                        )
-            energy, path, prev = 0.0, 0.0, here
-            for p in range(first, m + 1):
-                node = seq[p]
-                energy += rate * dist[prev, node]
-                path += dist[prev, node]
-                prev = node
-                if energy > battery + 1e-9:
-                    break
-                if p == m:  # back at the depot
-                    x = max(0.0, energy - b0)
-                    _, late = _walk(
-                        seq, first, m, here, t0 + time_per_energy * x, dur, ready, due, service
-                    )
-                    if hard and late > 1e-9:
-                        break
-                    cost = d0 + path + (penalty * (w0 + late) if w0 + late > 0 else 0.0)
-                    if cost < best_c:
-                        best_c, best_d, best_w = cost, d0 + path, w0 + late
-                        best_u, best_l, best_x = u, li, x
-                    break
-                for k in range(k_max):
-                    s = cand[node, seq[p + 1], k]
-                    to_s = energy + rate * dist[node, s]
-                    if to_s > battery + 1e-9:
-                        continue
-                    x = max(0.0, to_s - b0)
-                    leave, late = _walk(
-                        seq, first, p, here, t0 + time_per_energy * x, dur, ready, due, service
-                    )
-                    arrive = leave + dur[node, s]
-                    late += max(arrive - due[seq[0]], 0.0)
-                    if hard and late > 1e-9:
-                        continue
-                    _add_label(
-                        1 + p * k_max + k,
-                        d0 + path + dist[node, s],
-                        w0 + late,
-                        min(arrive, due[seq[0]]),
-                        b0 + x - to_s,
-                        penalty,
-                        u,
-                        li,
-                        x,
-                        lab_c,
-                        lab_d,
-                        lab_w,
-                        lab_t,
-                        lab_b,
-                        lab_prev,
-                        lab_prev_l,
-                        lab_x,
-                        count,
-                        cap,
-                    )
-    gaps = np.full(m, -1, dtype=np.int64)
-    charges = np.zeros(m)
-    if best_u < 0:
-        return np.inf, 0.0, gaps, charges
-    u, li, x = best_u, best_l, best_x
-    while u > 0:
-        gap = (u - 1) // k_max
-        gaps[gap] = cand[seq[gap], seq[gap + 1], (u - 1) % k_max]
-        charges[gap] = x
-        x = lab_x[u, li]
-        u, li = lab_prev[u, li], lab_prev_l[u, li]
-    return best_d, best_w, gaps, charges
-
-
-@njit(cache=True)
-def _walk(
-    seq: NDArray[np.int64],
-    first: int,
-    last: int,
-    here: int,
-    depart: float,
-    dur: FloatArray,
-    ready: FloatArray,
-    due: FloatArray,
-    service: FloatArray,
-) -> tuple[float, float]:
-    """Leave ``here`` at ``depart`` and serve ``seq[first..last]``: the departure from
-    ``seq[last]`` (the arrival when it is the depot at the end) and the time late in all (a
-    place reached after its window is served at its close)."""
-    clock = depart
-    prev = here
-    late = 0.0
-    for p in range(first, last + 1):
-        node = seq[p]
-        clock += dur[prev, node]
-        if clock > due[node]:
-            late += clock - due[node]
-            clock = due[node]
-        if p == seq.size - 1:
-            return clock, late
-        clock = max(clock, ready[node]) + service[node]
-        prev = node
-    return clock, late
-
-
-@njit(cache=True)
-def _add_label(
-    v: int,
-    d: float,
-    w: float,
-    t: float,
-    b: float,
-    penalty: float,
-    u: int,
-    li: int,
-    x: float,
-    lab_c: FloatArray,
-    lab_d: FloatArray,
-    lab_w: FloatArray,
-    lab_t: FloatArray,
-    lab_b: FloatArray,
-    lab_prev: NDArray[np.int64],
-    lab_prev_l: NDArray[np.int64],
-    lab_x: FloatArray,
-    count: NDArray[np.int64],
-    cap: int,
-) -> None:
-    """Keep the label unless one at ``v`` is as good on cost, time and battery; drop those
-    it is as good as; at most ``cap`` (the costliest goes)."""
-    c = d + (penalty * w if w > 0 else 0.0)
-    n = count[v]
-    for i in range(n):
-        if lab_c[v, i] <= c + 1e-9 and lab_t[v, i] <= t + 1e-9 and lab_b[v, i] >= b - 1e-9:
-            return
-    keep = 0
-    for i in range(n):
-        if not (c <= lab_c[v, i] + 1e-9 and t <= lab_t[v, i] + 1e-9 and b >= lab_b[v, i] - 1e-9):
-            lab_c[v, keep] = lab_c[v, i]
-            lab_d[v, keep] = lab_d[v, i]
-            lab_w[v, keep] = lab_w[v, i]
-            lab_t[v, keep] = lab_t[v, i]
-            lab_b[v, keep] = lab_b[v, i]
-            lab_prev[v, keep] = lab_prev[v, i]
-            lab_prev_l[v, keep] = lab_prev_l[v, i]
-            lab_x[v, keep] = lab_x[v, i]
-            keep += 1
-    slot = keep
-    if keep >= cap:
-        worst = 0
-        for i in range(keep):
-            if lab_c[v, i] > lab_c[v, worst]:
-                worst = i
-        if lab_c[v, worst] <= c:
-            count[v] = keep
-            return
-        slot = worst
-    else:
-        keep += 1
-    lab_c[v, slot] = c
-    lab_d[v, slot] = d
-    lab_w[v, slot] = w
-    lab_t[v, slot] = t
-    lab_b[v, slot] = b
-    lab_prev[v, slot] = u
-    lab_prev_l[v, slot] = li
-    lab_x[v, slot] = x
-    count[v] = keep

@@ -188,7 +188,8 @@ def build_legs(
 def _check_shape(rows: Sequence[Sequence[object]], name: str, n: int) -> None:
     if len(rows) != n:
         raise InvalidMatrixError(
-            f"matrix.{name} has {len(rows)} rows; expected {n} (depot + {n - 1} stops)",
+            f"matrix.{name} has {len(rows)} rows; expected {n} (the depot, the stops, then the "
+            "chargers on the way)",
             f"matrix.{name}",
         )
     for i, row in enumerate(rows):

@@ -219,17 +219,34 @@ def test_bad_chargers_on_the_way_are_422_naming_the_field(client, charger, field
     assert any(e["field"] == field for e in response.json()["errors"]), response.json()["errors"]
 
 
-def test_two_chargers_of_one_id_and_a_matrix_beside_chargers_are_422(client):
+def square(n: int, value: float) -> list[list[float]]:
+    return [[0.0 if i == j else value for j in range(n)] for i in range(n)]
+
+
+def test_two_chargers_of_one_id_and_a_matrix_without_the_chargers_rows_are_422(client):
     response = client.post("/v1/plans", json=PLAN_EXAMPLE | {"chargers": [CHARGER, CHARGER]})
     assert response.status_code == 422
     assert response.json()["errors"][0]["field"] == "chargers[1].id"
     n = len(PLAN_EXAMPLE["stops"]) + 1
-    matrix = {"distances_m": [[1000.0] * n] * n, "durations_s": [[100.0] * n] * n}
+    matrix = {"distances_m": square(n, 1000.0), "durations_s": square(n, 100.0)}
     response = client.post(
         "/v1/plans", json=PLAN_EXAMPLE | {"chargers": [CHARGER], "matrix": matrix}
     )
     assert response.status_code == 422
-    assert response.json()["errors"][0]["field"] == "chargers"
+    error = response.json()["errors"][0]
+    assert error["field"] == "matrix.distances_m" and "chargers" in error["message"]
+
+
+def test_a_client_matrix_with_the_chargers_rows_plans_on_its_own_distances(client):
+    # every leg 1 km and 100 s, the charger's too: the round drives the client's legs alone
+    n = len(PLAN_EXAMPLE["stops"]) + 2
+    matrix = {"distances_m": square(n, 1000.0), "durations_s": square(n, 100.0)}
+    body = PLAN_EXAMPLE | {"chargers": [CHARGER], "matrix": matrix}
+    response = client.post("/v1/plans", json=body)
+    assert response.status_code == 200, response.json()
+    answer = response.json()
+    assert answer["distance_source"] == "client"
+    assert answer["totals"]["distance_m"] == pytest.approx(1000.0 * len(answer["legs"]))
 
 
 def test_a_round_heavier_than_the_van_reloads_over_http(client):

@@ -11,7 +11,7 @@ import math
 
 import pytest
 
-from core.exceptions import InvalidParameterError, InvalidStopsError
+from core.exceptions import InvalidMatrixError, InvalidStopsError
 from core.params import Charger, RoadMatrix
 from core.planning.model import PlanProblem, PlanResult, StartState
 from core.planning.recharge import PARTIAL_CHARGE_MARGIN
@@ -140,7 +140,7 @@ def test_a_van_under_way_with_little_charge_charges_before_it_runs_out():
     assert result.charges[0].arrive < without.legs[without.first_infeasible_leg or 0].arrive
 
 
-def test_charger_ids_are_their_own_and_a_matrix_has_no_rows_for_them():
+def test_charger_ids_are_their_own_and_a_matrix_needs_rows_for_them():
     stop_id = summer_day(None).stops[0].id
     with pytest.raises(InvalidStopsError) as caught:
         plan(with_chargers(FAST | {"id": stop_id}))
@@ -161,6 +161,6 @@ def test_charger_ids_are_their_own_and_a_matrix_has_no_rows_for_them():
     problem = with_chargers(FAST)
     n = len(problem.stops) + 1
     matrix = RoadMatrix(distances_m=[[0.0] * n] * n, durations_s=[[0.0] * n] * n)
-    with pytest.raises(InvalidParameterError) as caught:
+    with pytest.raises(InvalidMatrixError) as caught:  # no row for the charger
         plan(problem.model_copy(update={"matrix": matrix}))
-    assert caught.value.field == "chargers"
+    assert caught.value.field == "matrix.distances_m" and "chargers" in caught.value.message

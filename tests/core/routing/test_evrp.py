@@ -10,6 +10,7 @@ import json
 import math
 import subprocess
 import sys
+from dataclasses import replace
 from functools import cache
 from pathlib import Path
 
@@ -17,24 +18,30 @@ import numpy as np
 import pytest
 
 from benchmarks.evrptw import FOLDER, check, read
-from core.routing.evrp import (
-    NO_ROUTE,
-    EvrpInstance,
-    _station_candidates,
-    route_with_stations,
-    solve_evrptw,
-)
+from core.routing.effort import Effort
+from core.routing.evrp import EvrpInstance, VehicleKind, _Search, solve_evrptw
+from core.routing.stations import NO_ROUTE
 
 ROOT = Path(__file__).resolve().parents[3]
 
 
 def instance(
-    xy: list[tuple[float, float]], kinds: str, due: float = 1000.0, **changes
+    xy: list[tuple[float, float]],
+    kinds: str,
+    due: float | np.ndarray = 1000.0,
+    capacity: float = 100.0,
+    battery: float = 50.0,
+    time_per_energy: float = 2.0,
+    **changes,
 ) -> EvrpInstance:
-    """Places at ``xy`` (``kinds``: d depot, c customer, f station), unit speed and energy."""
+    """Places at ``xy`` (``kinds``: d depot, c customer, f station), unit speed and energy,
+    as many vehicles as places."""
     points = np.array(xy, dtype=float)
     distance = np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
     n = len(xy)
+    vehicles = VehicleKind(
+        count=n, energy=distance.copy(), battery=battery, initial=battery, capacity=capacity
+    )
     fields = {
         "distance": distance,
         "duration": distance.copy(),
@@ -44,10 +51,8 @@ def instance(
         "demand": np.array([1.0 if k == "c" else 0.0 for k in kinds]),
         "customers": [i for i, k in enumerate(kinds) if k == "c"],
         "stations": [i for i, k in enumerate(kinds) if k == "f"],
-        "capacity": 100.0,
-        "battery": 50.0,
-        "energy_per_distance": 1.0,
-        "time_per_energy": 2.0,
+        "charge_time": np.full(n, time_per_energy),
+        "kinds": [vehicles],
     }
     return EvrpInstance(**(fields | changes))
 
@@ -58,8 +63,9 @@ def on_a_line(**changes) -> EvrpInstance:
 
 
 def charged(inst: EvrpInstance, route: list[int], penalty: float = math.inf):
-    candidates = _station_candidates(inst.distance, np.array(inst.stations))
-    return route_with_stations(inst, route, candidates, penalty)
+    search = _Search(inst, np.random.default_rng(0))
+    search.penalty = penalty
+    return search.charged(0, route)
 
 
 def test_a_route_on_a_line_charges_what_the_way_to_the_next_charge_takes():
@@ -75,6 +81,43 @@ def test_a_route_on_a_line_charges_what_the_way_to_the_next_charge_takes():
         (0, 0.0),
     ]
     assert result.warp == 0.0
+
+
+def test_a_vehicle_leaving_with_less_charges_more_at_the_first_station():
+    # leaving with 30 of 50: D→S leaves 10; S→C→S takes 40: charge 30 (40 ≤ 50 on leaving);
+    # S→D takes 20: charge 20. The start charges nothing (no station there).
+    inst = on_a_line()
+    kind = replace(inst.kinds[0], initial=30.0)
+    result = charged(replace(inst, kinds=[kind]), [1])
+    assert [(v.place, v.charge) for v in result.visits] == [
+        (0, 0.0),
+        (2, pytest.approx(30.0)),
+        (1, 0.0),
+        (2, pytest.approx(20.0)),
+        (0, 0.0),
+    ]
+    # leaving with 15: D→S leaves no room to reach S (20 > 15): no route
+    low = replace(inst, kinds=[replace(kind, initial=15.0)])
+    assert charged(low, [1]) is NO_ROUTE
+
+
+def test_a_fleet_too_small_serves_what_it_can_and_says_what_it_left_out():
+    # two customers 40 out on either side, a station halfway to each; one vehicle carrying
+    # one: it serves one (80 with two charges) and leaves the other out
+    inst = instance([(0, 0), (40, 0), (-40, 0), (20, 0), (-20, 0)], "dccff", capacity=1.0)
+    one = replace(inst, kinds=[replace(inst.kinds[0], count=1)])
+    solution = solve_evrptw(one, Effort.starting_now(0.5, 60.0))
+    assert solution.vehicles == 1 and len(solution.left_out) == 1
+    assert solution.distance == pytest.approx(80.0)
+    both = solve_evrptw(inst, Effort.starting_now(0.5, 60.0))
+    assert both.vehicles == 2 and not both.left_out
+    assert both.distance == pytest.approx(160.0)
+
+
+def test_the_same_work_gives_the_same_routes():
+    inst = small()
+    first, again = (solve_evrptw(inst, Effort(0.3, math.inf, seed=3)) for _ in range(2))
+    assert first == again and first.ended == "work"
 
 
 def test_a_window_that_charging_makes_unreachable_is_no_route():
@@ -151,10 +194,10 @@ def test_a_small_instance_is_solved_as_well_as_every_split_and_order_allows():
     inst = small()
     vans, distance = every_split_and_order(inst)
     assert vans < 10**6
-    solution = solve_evrptw(inst, time_limit_s=2.0)
-    assert solution.vehicles == vans
+    solution = solve_evrptw(inst, Effort.starting_now(2.0, 60.0))
+    assert solution.vehicles == vans and solution.ended == "work"
     assert solution.distance == pytest.approx(distance, rel=1e-6)
-    routes = [[(v.place, v.charge) for v in route] for route in solution.routes]
+    routes = [[(v.place, v.charge) for v in route.visits] for route in solution.routes]
     assert check(inst, routes) is None
 
 

@@ -1,0 +1,367 @@
+"""The charging stations of one route with a fixed order of customers: which stations between
+them and how much to charge at each (partial recharge), at the least cost, by labels over the
+route's gaps (Numba).
+
+At most one station per gap, among the :data:`STATIONS_PER_GAP` with the least detour. A
+charge gives what the way to the next station (or the depot) takes — the least, so the least
+time. Labels of cost, time and battery on arrival are kept when no other is as good on all
+three (at most :data:`LABELS_PER_NODE`). The least cost that keeps every window, the battery
+and the latest return wins — or, with a penalty per unit of time late, the least cost plus the
+penalised lateness (Vidal et al.'s time warp, *Computers & OR* 40 (2013) 475). The labelling
+follows Keskin & Çatay, *Transportation Research C* 65 (2016) 111 (partial recharge) and
+Schneider, Stenger & Goeke, *Transportation Science* 48 (2014) 500.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from core.arrays import FloatArray
+
+#: Stations considered on each gap between two places of a route, least detour first.
+STATIONS_PER_GAP = 4
+#: Labels kept at each station (or the start) of a route.
+LABELS_PER_NODE = 6
+#: A label's fields: cost (with the penalised lateness), cost alone, lateness, time, battery on
+#: arrival, the label it came from (node and slot) and what that one charged.
+_C, _D, _W, _T, _B, _PREV, _PREV_L, _X = range(8)
+_FIELDS = 8
+_EPS = 1e-9
+
+
+@dataclass(frozen=True)
+class Visit:
+    """A place of a route and the energy charged there (0 but at stations)."""
+
+    place: int
+    charge: float
+
+
+@dataclass(frozen=True)
+class RouteFacts:
+    """What one kind of vehicle's routes are evaluated on (places by index).
+
+    Attributes
+    ----------
+    cost, duration, energy
+        Each arc's cost (the objective), travel time and energy.
+    ready, due, service
+        Each place's window and service time (at a station: the time to plug in and out); the
+        depot's ``due`` is the latest return.
+    charge_time
+        Time to charge one unit of energy at each place (used at the stations).
+    battery, initial
+        The most energy the battery holds above its floor, and what it holds at departure
+        (a vehicle charges only at stations).
+    start_time
+        The departure from the route's first place.
+    """
+
+    cost: FloatArray
+    duration: FloatArray
+    energy: FloatArray
+    ready: FloatArray
+    due: FloatArray
+    service: FloatArray
+    charge_time: FloatArray
+    battery: float
+    initial: float
+    start_time: float
+
+
+@dataclass(frozen=True)
+class Charged:
+    """A route with its stations: its cost, the time it is late in all (``warp``, only with a
+    finite penalty), its load, and per gap between two places of ``seq`` (start, customers,
+    depot) the station visited (−1: none) and the energy charged there."""
+
+    distance: float
+    warp: float
+    load: float = 0.0
+    seq: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    gaps: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    charges: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+    def cost(self, penalty: float) -> float:
+        return self.distance + (penalty * self.warp if self.warp > 0 else 0.0)
+
+    @property
+    def visits(self) -> list[Visit]:
+        """The places in order, start first and depot last, stations included (built only
+        for the answer: the search compares costs)."""
+        visits = [Visit(int(self.seq[0]), 0.0)] if self.seq.size else []
+        for p in range(self.seq.size - 1):
+            if self.gaps[p] >= 0:
+                visits.append(Visit(int(self.gaps[p]), float(self.charges[p])))
+            visits.append(Visit(int(self.seq[p + 1]), 0.0))
+        return visits
+
+
+NO_ROUTE = Charged(math.inf, 0.0)
+
+
+def station_candidates(cost: FloatArray, stations: NDArray[np.int64]) -> NDArray[np.int64]:
+    """For each arc, the :data:`STATIONS_PER_GAP` stations of least detour (by cost)."""
+    if stations.size == 0:
+        return np.zeros((*cost.shape, 0), dtype=np.int64)
+    detour = cost[:, stations][:, None, :] + cost[stations, :].T[None, :, :]
+    best = np.argsort(detour, axis=2, kind="stable")[:, :, :STATIONS_PER_GAP]
+    return stations[best]
+
+
+def route_with_stations(
+    facts: RouteFacts,
+    seq: NDArray[np.int64],
+    candidates: NDArray[np.int64],
+    penalty: float = math.inf,
+) -> tuple[float, float, NDArray[np.int64], FloatArray]:
+    """``seq`` (start, customers in order, depot) with the stations and charges it needs at
+    the least cost, plus ``penalty`` per unit of time late (a place reached after its window
+    is served at its close, the lateness counted; infinite: never late): its cost, lateness,
+    and per gap the station (−1: none) and the energy charged there. Infinite cost when no
+    choice keeps the battery (and the windows)."""
+    f = facts
+    lab = np.zeros((1 + (seq.size - 1) * candidates.shape[2], LABELS_PER_NODE, _FIELDS))
+    return _labels(
+        seq,
+        f.cost,
+        f.duration,
+        f.energy,
+        f.ready,
+        f.due,
+        f.service,
+        f.charge_time,
+        candidates,
+        f.battery,
+        f.initial,
+        f.start_time,
+        penalty,
+        lab,
+    )
+
+
+@njit(cache=True)
+def _labels(
+    seq: NDArray[np.int64],
+    cost: FloatArray,
+    dur: FloatArray,
+    energy: FloatArray,
+    ready: FloatArray,
+    due: FloatArray,
+    service: FloatArray,
+    charge_time: FloatArray,
+    cand: NDArray[np.int64],
+    battery: float,
+    initial: float,
+    start_time: float,
+    penalty: float,
+    lab: FloatArray,
+) -> tuple[float, float, NDArray[np.int64], FloatArray]:
+    """Labels over the route's charge points — the start (node 0), then station k of gap p
+    (between ``seq[p]`` and ``seq[p + 1]``, node ``1 + p·K + k``), each extended in turn
+    (:func:`_extend`); the best that reaches the depot, traced back (:func:`_traced`)."""
+    m = seq.size - 1
+    nodes = lab.shape[0]
+    count = np.zeros(nodes, dtype=np.int64)
+    lab[0, 0, _T] = start_time
+    lab[0, 0, _B] = initial
+    lab[0, 0, _PREV] = -1.0
+    count[0] = 1
+    best = np.array([np.inf, 0.0, 0.0, -1.0, -1.0, 0.0])  # cost, d, w, node, slot, charge
+    for u in range(nodes):
+        for li in range(count[u]):
+            _extend(
+                u, li, seq, cost, dur, energy, ready, due, service, charge_time, cand,
+                battery, penalty, lab, count, best,
+            )  # fmt: skip
+    gaps = np.full(m, -1, dtype=np.int64)
+    charges = np.zeros(m)
+    if best[3] < 0:
+        return np.inf, 0.0, gaps, charges
+    _traced(best, lab, seq, cand, gaps, charges)
+    return best[1], best[2], gaps, charges
+
+
+@njit(cache=True)
+def _extend(
+    u: int,
+    li: int,
+    seq: NDArray[np.int64],
+    cost: FloatArray,
+    dur: FloatArray,
+    energy: FloatArray,
+    ready: FloatArray,
+    due: FloatArray,
+    service: FloatArray,
+    charge_time: FloatArray,
+    cand: NDArray[np.int64],
+    battery: float,
+    penalty: float,
+    lab: FloatArray,
+    count: NDArray[np.int64],
+    best: FloatArray,
+) -> None:
+    """Label ``li`` of node ``u`` driven on: to each candidate station of each later gap it
+    reaches, charging at ``u`` what the way there takes beyond its battery (a new label), and
+    to the depot (the best so far). The start charges nothing."""
+    m = seq.size - 1
+    k_max = cand.shape[2]
+    end = seq[m]
+    hard = not np.isfinite(penalty)
+    d0, w0, t0, b0 = lab[u, li, _D], lab[u, li, _W], lab[u, li, _T], lab[u, li, _B]
+    if u == 0:
+        here, first, limit, plug = seq[0], 1, b0, 0.0
+        for k in range(k_max):  # a station straight from the start, before the first customer
+            s = cand[seq[0], seq[1], k]
+            arrive = t0 + dur[here, s]
+            late = max(arrive - due[end], 0.0)
+            if energy[here, s] <= b0 + _EPS and not (hard and late > _EPS):
+                _add_label(
+                    lab, count, 1 + k, cost[here, s], late, min(arrive, due[end]),
+                    b0 - energy[here, s], penalty, u, li, 0.0,
+                )  # fmt: skip
+    else:
+        gap = (u - 1) // k_max
+        here, first, limit = cand[seq[gap], seq[gap + 1], (u - 1) % k_max], gap + 1, battery
+        plug = service[here]
+    used, path, prev = 0.0, 0.0, here
+    for p in range(first, m + 1):
+        node = seq[p]
+        used += energy[prev, node]
+        path += cost[prev, node]
+        prev = node
+        if used > limit + _EPS:
+            return
+        if p == m:  # back at the depot
+            x = max(0.0, used - b0)
+            leave = t0 + plug + charge_time[here] * x
+            _, late = _walk(seq, first, m, here, leave, dur, ready, due, service)
+            if hard and late > _EPS:
+                return
+            c = d0 + path + (penalty * (w0 + late) if w0 + late > 0 else 0.0)
+            if c < best[0]:
+                best[0], best[1], best[2] = c, d0 + path, w0 + late
+                best[3], best[4], best[5] = u, li, x
+            return
+        for k in range(k_max):
+            s = cand[node, seq[p + 1], k]
+            to_s = used + energy[node, s]
+            if to_s > limit + _EPS:
+                continue
+            x = max(0.0, to_s - b0)
+            leave = t0 + plug + charge_time[here] * x
+            leave, late = _walk(seq, first, p, here, leave, dur, ready, due, service)
+            arrive = leave + dur[node, s]
+            late += max(arrive - due[end], 0.0)
+            if hard and late > _EPS:
+                continue
+            _add_label(
+                lab, count, 1 + p * k_max + k, d0 + path + cost[node, s], w0 + late,
+                min(arrive, due[end]), b0 + x - to_s, penalty, u, li, x,
+            )  # fmt: skip
+
+
+@njit(cache=True)
+def _traced(
+    best: FloatArray,
+    lab: FloatArray,
+    seq: NDArray[np.int64],
+    cand: NDArray[np.int64],
+    gaps: NDArray[np.int64],
+    charges: FloatArray,
+) -> None:
+    """The stations and charges of the best label's path, gap by gap (in place)."""
+    k_max = cand.shape[2]
+    u, li, x = int(best[3]), int(best[4]), best[5]
+    while u > 0:
+        gap = (u - 1) // k_max
+        gaps[gap] = cand[seq[gap], seq[gap + 1], (u - 1) % k_max]
+        charges[gap] = x
+        x = lab[u, li, _X]
+        u, li = int(lab[u, li, _PREV]), int(lab[u, li, _PREV_L])
+
+
+@njit(cache=True)
+def _walk(
+    seq: NDArray[np.int64],
+    first: int,
+    last: int,
+    here: int,
+    depart: float,
+    dur: FloatArray,
+    ready: FloatArray,
+    due: FloatArray,
+    service: FloatArray,
+) -> tuple[float, float]:
+    """Leave ``here`` at ``depart`` and serve ``seq[first..last]``: the departure from
+    ``seq[last]`` (the arrival when it is the depot at the end) and the time late in all (a
+    place reached after its window is served at its close)."""
+    clock = depart
+    prev = here
+    late = 0.0
+    for p in range(first, last + 1):
+        node = seq[p]
+        clock += dur[prev, node]
+        if clock > due[node]:
+            late += clock - due[node]
+            clock = due[node]
+        if p == seq.size - 1:
+            return clock, late
+        clock = max(clock, ready[node]) + service[node]
+        prev = node
+    return clock, late
+
+
+@njit(cache=True)
+def _add_label(
+    lab: FloatArray,
+    count: NDArray[np.int64],
+    v: int,
+    d: float,
+    w: float,
+    t: float,
+    b: float,
+    penalty: float,
+    u: int,
+    li: int,
+    x: float,
+) -> None:
+    """Keep the label at node ``v`` unless one there is as good on cost, time and battery;
+    drop those it is as good as; at most the labels' room (the costliest goes)."""
+    c = d + (penalty * w if w > 0 else 0.0)
+    n = count[v]
+    for i in range(n):
+        if lab[v, i, _C] <= c + _EPS and lab[v, i, _T] <= t + _EPS and lab[v, i, _B] >= b - _EPS:
+            return
+    keep = 0
+    for i in range(n):
+        dominated = c <= lab[v, i, _C] + _EPS and t <= lab[v, i, _T] + _EPS
+        if not (dominated and b >= lab[v, i, _B] - _EPS):
+            lab[v, keep, :] = lab[v, i, :]
+            keep += 1
+    slot = keep
+    if keep >= lab.shape[1]:
+        worst = 0
+        for i in range(keep):
+            if lab[v, i, _C] > lab[v, worst, _C]:
+                worst = i
+        if lab[v, worst, _C] <= c:
+            count[v] = keep
+            return
+        slot = worst
+    else:
+        keep += 1
+    lab[v, slot, _C] = c
+    lab[v, slot, _D] = d
+    lab[v, slot, _W] = w
+    lab[v, slot, _T] = t
+    lab[v, slot, _B] = b
+    lab[v, slot, _PREV] = u
+    lab[v, slot, _PREV_L] = li
+    lab[v, slot, _X] = x
+    count[v] = keep
