@@ -259,8 +259,8 @@ class TripFields(Params):
         description="Most trips from the depot (1–20): with more than 1, the van comes back to "
         "reload (its payload back to payload_kg) when its stops take more than it carries; "
         "every return to the depot reloads then, one to charge too (the van stands the longer "
-        "of the two), and returns only to charge do not count. In /v1/plans: rounds without "
-        "time windows and without start_state.",
+        "of the two), and returns only to charge do not count. With start_state the first "
+        "trip carries what is aboard.",
     )
     reload_minutes: float = Field(
         15.0, ge=0, le=MAX_RELOAD_MINUTES, description="Minutes to reload at the depot, 0–240."

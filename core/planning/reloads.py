@@ -1,10 +1,12 @@
 """Several trips of one van: a round whose stops take more than the van carries comes back to
 the depot to reload (``max_trips``, ``reload_minutes``).
 
-The round trip's order stays: walking it from the depot, the van comes back to reload before
-the first stop whose delivery it no longer carries (the payload back to ``payload_kg``), as
-often as it must; each trip is then put in its own best order. More trips than ``max_trips``
-is an error naming the stops. The timeline stands the van at the depot, parked, for
+Without time windows the round trip's order stays: walking it from the depot (or from the van's
+position when it is under way, with what it carries), the van comes back to reload before the
+first stop whose delivery it no longer carries (the payload back to ``payload_kg``), as often
+as it must; each trip is then put in its own best order. With time windows the fleet search
+with this one van places the reloads (:mod:`core.planning.round`). More trips than
+``max_trips`` is an error naming the stops. The timeline stands the van at the depot, parked, for
 ``reload_minutes`` (:meth:`core.planning.timeline._Builder.reload`).
 """
 
@@ -14,6 +16,7 @@ from collections.abc import Callable
 
 from core.exceptions import InvalidStopsError
 from core.planning.model import PlanProblem
+from core.planning.start_state import start_payload_kg
 from core.routing.units import payload_units_down, payload_units_up
 
 #: A trip's places (the depot first and last) in a better order, the depot still first and last.
@@ -21,19 +24,8 @@ Reorder = Callable[[list[int]], list[int]]
 
 
 def reloads_allowed(problem: PlanProblem) -> bool:
-    """Whether the round may come back to reload: more than one trip, no time windows, not
-    under way."""
-    windowed = any(stop.time_windows for stop in problem.stops)
-    return problem.max_trips > 1 and not windowed and problem.start_state is None
-
-
-def _why_no_reload(problem: PlanProblem) -> str:
-    """Why a round does not come back to reload, as a dispatcher reads it."""
-    if problem.max_trips == 1:
-        return "with max_trips above 1, a round without time windows comes back to reload"
-    if problem.start_state is not None:
-        return "a round planned from start_state does not come back to reload"
-    return "a round with time windows does not come back to reload"
+    """Whether the round may come back to reload: more than one trip."""
+    return problem.max_trips > 1
 
 
 def check_payload(problem: PlanProblem) -> None:
@@ -48,7 +40,7 @@ def check_payload(problem: PlanProblem) -> None:
         if int(weights.sum()) > capacity:
             raise InvalidStopsError(
                 f"the stops' delivery_kg add up to {delivered:g} kg, more than the payload "
-                f"{payload:g} kg ({_why_no_reload(problem)})",
+                f"{payload:g} kg (with max_trips above 1 the round comes back to reload)",
                 "stops",
             )
         return
@@ -59,24 +51,27 @@ def check_payload(problem: PlanProblem) -> None:
                 f"{payload:g} kg: no trip carries it",
                 f"stops[{index}].delivery_kg",
             )
-    if int(weights.sum()) > capacity * problem.max_trips:
+    aboard = payload_units_down(start_payload_kg(problem))
+    if int(weights.sum()) > aboard + capacity * (problem.max_trips - 1):
+        carried = start_payload_kg(problem) + payload * (problem.max_trips - 1)
         raise InvalidStopsError(
-            f"the stops' delivery_kg add up to {delivered:g} kg, more than {problem.max_trips} "
-            f"trips of {payload:g} kg carry",
+            f"the stops' delivery_kg add up to {delivered:g} kg, more than the "
+            f"{carried:g} kg {problem.max_trips} trips carry (payload_kg {payload:g})",
             "stops",
         )
 
 
 def with_reloads(problem: PlanProblem, order: list[int], reorder: Reorder | None) -> list[int]:
-    """The round trip ``order`` (place indices, the depot first and last) with a return to
-    the depot before each stop the van no longer carries, each trip in its own best order
-    (``reorder``; None keeps the client's order); ``order`` when one load carries it all."""
+    """The round ``order`` (place indices from the depot, or the van's position when it is
+    under way, to the depot) with a return to the depot before each stop the van no longer
+    carries, each trip in its own best order (``reorder``; None keeps the client's order);
+    ``order`` when one load carries it all."""
     if not reloads_allowed(problem):
         return order
     weights = payload_units_up([stop.delivery_kg for stop in problem.stops])
     capacity = payload_units_down(problem.van.payload_kg)
-    trips: list[list[int]] = [[0]]
-    aboard = capacity
+    trips: list[list[int]] = [[order[0]]]
+    aboard = payload_units_down(start_payload_kg(problem))
     for place in order[1:-1]:
         weight = int(weights[place - 1])
         if weight > aboard:
@@ -94,4 +89,4 @@ def with_reloads(problem: PlanProblem, order: list[int], reorder: Reorder | None
         )
     if reorder is not None and len(trips) > 1:
         trips = [reorder(trip) for trip in trips]
-    return [0, *(place for trip in trips for place in trip[1:])]
+    return [order[0], *(place for trip in trips for place in trip[1:])]

@@ -28,8 +28,9 @@ def check_start(
 ) -> dt.datetime | None:
     """The departure from the van's position in the round's zone, or None without a start
     state; raises :class:`core.exceptions.InvalidParameterError` naming the field (``field``
-    and below) for what cannot be planned from it. A round (not ``fleet``) carries every
-    stop from where it is; a fleet's van carries no more than its payload."""
+    and below) for what cannot be planned from it. A round (not ``fleet``) of one trip
+    carries every stop from where it is; a van that may reload carries no more than its
+    payload."""
     state = problem.start_state
     if state is None:
         return None
@@ -47,7 +48,8 @@ def check_start(
             f"{field}.soc",
         )
     delivered = sum(stop.delivery_kg for stop in problem.stops)
-    if not fleet and state.payload_kg is not None and state.payload_kg < delivered - 1e-9:
+    one_load = not fleet and problem.max_trips == 1  # else it may come back to reload
+    if one_load and state.payload_kg is not None and state.payload_kg < delivered - 1e-9:
         raise InvalidParameterError(
             f"payload_kg {state.payload_kg:g} is less than the {delivered:g} kg the stops left "
             "take",
