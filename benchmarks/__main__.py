@@ -3,6 +3,7 @@
 from benchmarks import (
     bench_calibration,
     bench_energy,
+    bench_evrptw,
     bench_fleet,
     bench_homberger,
     bench_planner,
@@ -22,6 +23,7 @@ for module in (
     bench_fleet,
     bench_homberger,
     evrptw,
+    bench_evrptw,
     bench_serving,
     bench_soak,
 ):

@@ -43,10 +43,11 @@ TOLERANCE = 1e-6
 @dataclass(frozen=True)
 class Instance:
     """An instance file: the ids of its places (depot, customers, stations in the solver's
-    order) and the problem."""
+    order), their coordinates and the problem."""
 
     name: str
     ids: list[str]
+    xy: np.ndarray
     problem: EvrpInstance
 
 
@@ -86,7 +87,7 @@ def read(path: Path) -> Instance:
         charge_time=np.full(len(order), values["g"]),
         kinds=[vehicles],
     )
-    return Instance(path.name.split("_")[0], [r[0] for r in order], problem)
+    return Instance(path.name.split("_")[0], [r[0] for r in order], xy, problem)
 
 
 def check(instance: EvrpInstance, routes: list[list[tuple[int, float]]]) -> str | None:

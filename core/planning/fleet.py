@@ -116,44 +116,10 @@ def plan_fleet(
     started = time.perf_counter()
     effort = problem.effort(problem.time_limit_s)
     shifts, timezone_name = check_fleet(problem)
-    under_way = [k for k, v in enumerate(problem.vehicles) if v.start_state is not None]
-    positions = [
-        Place(id=START_ID, lat=state.lat, lon=state.lon)
-        for k in under_way
-        if (state := problem.vehicles[k].start_state) is not None
-    ]
-    places = [*problem.places, *positions, *problem.chargers]
-    start_fields = [f"vehicles[{k}].start_state" for k in under_way]
-    legs = legs_for(problem, router, places, start_fields)
-    for index in legs.unreachable():
-        if index > len(problem.stops) and index < len(places) - len(problem.chargers):
-            raise NoRouteError(
-                "no road links the van's position with the depot",
-                round_field(problem, places, index, start_fields),
-            )
-    starts = [0] * len(shifts)
-    for n, k in enumerate(under_way):
-        starts[k] = len(problem.stops) + 1 + n
-    first = min(shift.start for shift in shifts)
-    last = max(shift.end for shift in shifts if shift.end is not None)
-    # One forecast for the whole day, shared by every van.
-    day_weather = forecast_for(
-        problem.weather,
-        weather_service,
-        problem.depot.lat,
-        problem.depot.lon,
-        first,
-        last.timestamp() - first.timestamp() + 2 * 3600.0,
+    scene, starts, weather_warnings = _fleet_scene(
+        problem, shifts, timezone_name, router, weather_service
     )
-    fastest = max(v.van.vehicle.max_acceleration_mps2 for v in problem.vehicles)
-    too_fast = client_legs_too_fast(legs, fastest)
-    scene = Scene(
-        places,
-        legs,
-        timezone_name,
-        lambda _begin, _span_s: day_weather,
-        (too_fast,) if too_fast else (),
-    )
+    legs = scene.legs
     remembering = None if router is None else RememberingRouter(router)
     charging = problem.depot.charger is not None or bool(problem.chargers)
     routed = search(
@@ -180,12 +146,62 @@ def plan_fleet(
         timezone=timezone_name,
         distance_source=legs.source,
         warnings=[
-            *day_weather[1],
+            *weather_warnings,
             *routed.warnings,
             *_payload_short(problem, routed.unassigned),
             *cut_short(routed.ended),
         ],
     )
+
+
+def _fleet_scene(
+    problem: FleetProblem,
+    shifts: list[VanShift],
+    timezone_name: str,
+    router: RoadRouter | None,
+    weather_service: WeatherService | None,
+) -> tuple[Scene, list[int], list[str]]:
+    """The day's places (the depot, the stops, the positions of the vans under way, the
+    chargers), their legs and one forecast for the whole day shared by every van; the place
+    each van sets off from; what the weather's source says of itself."""
+    under_way = [k for k, v in enumerate(problem.vehicles) if v.start_state is not None]
+    positions = [
+        Place(id=START_ID, lat=state.lat, lon=state.lon)
+        for k in under_way
+        if (state := problem.vehicles[k].start_state) is not None
+    ]
+    places = [*problem.places, *positions, *problem.chargers]
+    start_fields = [f"vehicles[{k}].start_state" for k in under_way]
+    legs = legs_for(problem, router, places, start_fields)
+    for index in legs.unreachable():
+        if index > len(problem.stops) and index < len(places) - len(problem.chargers):
+            raise NoRouteError(
+                "no road links the van's position with the depot",
+                round_field(problem, places, index, start_fields),
+            )
+    starts = [0] * len(shifts)
+    for n, k in enumerate(under_way):
+        starts[k] = len(problem.stops) + 1 + n
+    first = min(shift.start for shift in shifts)
+    last = max(shift.end for shift in shifts if shift.end is not None)
+    day_weather = forecast_for(
+        problem.weather,
+        weather_service,
+        problem.depot.lat,
+        problem.depot.lon,
+        first,
+        last.timestamp() - first.timestamp() + 2 * 3600.0,
+    )
+    fastest = max(v.van.vehicle.max_acceleration_mps2 for v in problem.vehicles)
+    too_fast = client_legs_too_fast(legs, fastest)
+    scene = Scene(
+        places,
+        legs,
+        timezone_name,
+        lambda _begin, _span_s: day_weather,
+        (too_fast,) if too_fast else (),
+    )
+    return scene, starts, list(day_weather[1])
 
 
 def _payload_short(problem: FleetProblem, unassigned: list[Unassigned]) -> list[str]:
@@ -449,55 +465,18 @@ def search(
 ) -> Routed:
     """Solve and verify until every route holds or :data:`MAX_RESOLVES` re-solves are spent,
     each solve its share of ``effort``'s work; ``minimize_vehicles``: fewer vans first, then
-    the objective. With ``charging`` and stops then left out for their battery, the fleet is
-    planned again with charges between stops (:mod:`core.planning.fleet_charging`)."""
+    the objective. With ``charging`` and stops then left out for their battery (or fewer vans
+    first), the fleet is planned again with charges between stops
+    (:mod:`core.planning.fleet_charging`)."""
     times = LearnedTimes(day.duration_s, day.finite, day.horizon_s)
     calibrate(day, times)
-    budgets = [
-        e.budget_j if shift.battery_enforced else None
-        for shift, e in zip(day.shifts, day.estimates, strict=True)
-    ]
-    routes: list[list[int]] = [[] for _ in day.vans]
-    results: dict[int, PlanResult] = {}
-    failures: dict[int, Failure] = {}
-    initial: list[list[int]] | None = None
-    simulated: dict[int, tuple[list[int], PlanResult]] = {}
-    ends: list[SearchEnd] = []
-    rounds = 0
     # a limit too short for the verification's reserve still leaves the search half of it
     reserve_s = min(verification_reserve_s(day), effort.left_s() / 2)
-    while rounds <= MAX_RESOLVES:
-        if rounds and effort.left_s() <= reserve_s:
-            ends.append("time_limit")
-            break
-        rules = Feasibility(day, times.matrix(), budgets)
-        share = RESOLVE_SHARE if rounds else CHARGING_FIRST_SHARE if charging else FIRST_SOLVE_SHARE
-        outcome = solve_routes(
-            routing_input(rules, minimize_vehicles),
-            effort.share(share).keeping(reserve_s),
-            initial,
-        )
-        rounds += 1
-        ends.append(outcome.ended if outcome is not None else "work")
-        # a re-solve that found nothing (out of time) keeps the routes that held before it
-        kept = initial if initial is not None else [[] for _ in day.vans]
-        routes = outcome.routes if outcome is not None else kept
-        simulated = _simulated(day, routes, simulated, times)
-        results = {v: result for v, (_, result) in simulated.items()}
-        failures = {
-            v: failure
-            for v, result in results.items()
-            if (failure := _failure(day, v, result)) is not None
-        }
-        if not failures:
-            break
-        for v, failure in failures.items():
-            if failure.reason == "battery":
-                budgets[v] = _tightened(budgets[v], results[v])
-        rules = Feasibility(day, times.matrix(), budgets)
-        initial = [fitting(rules, v, r) if v in failures else r for v, r in enumerate(routes)]
+    share = CHARGING_FIRST_SHARE if charging else FIRST_SOLVE_SHARE
+    solved = _solved(day, times, minimize_vehicles, (effort, share), reserve_s)
+    routes, results, ends = solved.routes, solved.results, solved.ends
     left_out: dict[int, Failure] = {}
-    for v, failure in failures.items():
+    for v, failure in solved.failures.items():
         repaired = _repair(day, v, routes[v], failure)
         routes[v] = repaired.route
         left_out |= repaired.removed
@@ -505,27 +484,14 @@ def search(
             results.pop(v, None)
         else:
             results[v] = repaired.result
-    rules = Feasibility(day, times.matrix(), budgets)
+    rules = Feasibility(day, times.matrix(), solved.budgets)
     left_out |= _given_to_idle(day, rules, routes, results)
     unassigned = _unassigned(rules, routes, left_out)
-    if charging and any(u.reason == "battery" for u in unassigned):
-        charged = charging_routes(
-            day,
-            times.matrix(),
-            routes,
-            minimize_vehicles,
-            effort.share(CHARGING_SHARE).keeping(reserve_s / 2),
+    # with fewer vans first, charging may let fewer vans serve it all
+    if charging and (minimize_vehicles or any(u.reason == "battery" for u in unassigned)):
+        routes, results, unassigned = _charged(
+            day, rules, (routes, results, unassigned), minimize_vehicles, effort, reserve_s, ends
         )
-        ends.append(charged.ended)
-        if measure(day, charged.routes, charged.results, minimize_vehicles) < measure(
-            day, routes, results, minimize_vehicles
-        ):
-            routes, results = charged.routes, charged.results
-            unassigned = _unassigned(rules, routes, charged.removed)
-        routes, results, unassigned, inserted = serve_with_charging(
-            day, routes, results, unassigned, minimize_vehicles, effort
-        )
-        ends.append(inserted)
     for v in day.vans:  # a van under way with no stop left drives back to the depot
         if day.starts[v] and not routes[v]:
             results[v] = day.simulate(v, [])
@@ -537,7 +503,108 @@ def search(
             if (routes[v] or day.starts[v]) and v in results
         ],
         unassigned=unassigned,
-        verification_rounds=rounds,
+        verification_rounds=solved.rounds,
         objective_value=sum(day.estimates[v].route_cost(r) for v, r in enumerate(routes) if r),
         ended=combined(ends),
     )
+
+
+@dataclass
+class _Solved:
+    """The routes of the solves and their simulated days, the rules they still break, the
+    energy budgets they were searched with, how many solves and how each stopped."""
+
+    routes: list[list[int]]
+    results: dict[int, PlanResult]
+    failures: dict[int, Failure]
+    budgets: list[float | None]
+    rounds: int
+    ends: list[SearchEnd]
+
+
+def _solved(
+    day: FleetDay,
+    times: LearnedTimes,
+    minimize_vehicles: bool,
+    effort: tuple[Effort, float],
+    reserve_s: float,
+) -> _Solved:
+    """Solve (the first with its share of ``effort``'s work, re-solves
+    :data:`RESOLVE_SHARE`), simulate
+    each route, and solve again from the routes that held with the budgets of those that ran
+    short made smaller, until every route holds or :data:`MAX_RESOLVES` re-solves are spent."""
+    whole, first_share = effort
+    budgets = [
+        e.budget_j if shift.battery_enforced else None
+        for shift, e in zip(day.shifts, day.estimates, strict=True)
+    ]
+    routes: list[list[int]] = [[] for _ in day.vans]
+    failures: dict[int, Failure] = {}
+    initial: list[list[int]] | None = None
+    simulated: dict[int, tuple[list[int], PlanResult]] = {}
+    ends: list[SearchEnd] = []
+    rounds = 0
+    while rounds <= MAX_RESOLVES:
+        if rounds and whole.left_s() <= reserve_s:
+            ends.append("time_limit")
+            break
+        rules = Feasibility(day, times.matrix(), budgets)
+        share = RESOLVE_SHARE if rounds else first_share
+        outcome = solve_routes(
+            routing_input(rules, minimize_vehicles),
+            whole.share(share).keeping(reserve_s),
+            initial,
+        )
+        rounds += 1
+        ends.append(outcome.ended if outcome is not None else "work")
+        # a re-solve that found nothing (out of time) keeps the routes that held before it
+        kept = initial if initial is not None else [[] for _ in day.vans]
+        routes = outcome.routes if outcome is not None else kept
+        simulated = _simulated(day, routes, simulated, times)
+        failures = {
+            v: failure
+            for v, (_, result) in simulated.items()
+            if (failure := _failure(day, v, result)) is not None
+        }
+        if not failures:
+            break
+        for v in failures:
+            if failures[v].reason == "battery":
+                budgets[v] = _tightened(budgets[v], simulated[v][1])
+        rules = Feasibility(day, times.matrix(), budgets)
+        initial = [fitting(rules, v, r) if v in failures else r for v, r in enumerate(routes)]
+    results = {v: result for v, (_, result) in simulated.items()}
+    return _Solved(routes, results, failures, budgets, rounds, ends)
+
+
+def _charged(
+    day: FleetDay,
+    rules: Feasibility,
+    found: tuple[list[list[int]], dict[int, PlanResult], list[Unassigned]],
+    minimize_vehicles: bool,
+    effort: Effort,
+    reserve_s: float,
+    ends: list[SearchEnd],
+) -> tuple[list[list[int]], dict[int, PlanResult], list[Unassigned]]:
+    """The fleet planned again with charges between stops (:mod:`core.planning.fleet_charging`),
+    kept when it does better than the routes ``found`` without; then the stops still left out
+    inserted one at a time with the charges they need (:mod:`core.planning.charge_insertion`)."""
+    routes, results, unassigned = found
+    charged = charging_routes(
+        day,
+        rules.travel_s,
+        routes,
+        minimize_vehicles,
+        effort.share(CHARGING_SHARE).keeping(reserve_s / 2),
+    )
+    ends.append(charged.ended)
+    if measure(day, charged.routes, charged.results, minimize_vehicles) < measure(
+        day, routes, results, minimize_vehicles
+    ):
+        routes, results = charged.routes, charged.results
+        unassigned = _unassigned(rules, routes, charged.removed)
+    routes, results, unassigned, inserted = serve_with_charging(
+        day, routes, results, unassigned, minimize_vehicles, effort
+    )
+    ends.append(inserted)
+    return routes, results, unassigned

@@ -12,9 +12,10 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    and full, what it holds at departure, its payload, its shift and where it sets off; each
    charger's charge time per joule (the van's charging curve at the charger's power, reserve
    to 80 %) and its plug-in time; each stop's window (the first opening to the last close).
-2. **The search** starts from the routes the fleet's search found without charging (the
-   stops left out inserted where they cost least) and serves every stop it can, then fewest
-   vans (when asked), then the objective.
+2. **The search** starts from its own routes of the stops, found with part of the charging
+   time in the arcs (when every van leaves the depot), or else from the routes the fleet's
+   search found without charging (the stops left out inserted where they cost least), and
+   serves every stop it can, then fewest vans (when asked), then the objective.
 3. **Verification**: each route is simulated with its charges fitted to what the simulation
    says each stretch takes (:func:`core.planning.recharge.with_charges`), the charge points
    free only between the other vans' charges (:class:`Bookings`). A route the simulation
@@ -59,8 +60,10 @@ from core.routing.units import payload_units_down
 CHARGE_TIME_SOC = 0.8
 #: The share of each van's battery (and of its charge at departure) the search plans with:
 #: the estimates do not see every draw of the simulation (the weather through the day, the
-#: standing loads while waiting), and a charge cannot make up a stretch beyond a full battery.
-BATTERY_MARGIN = 0.9
+#: standing loads while waiting). Small: a route the simulation finds short makes its kind's
+#: battery smaller by the shortfall (:func:`charging_routes`), and every percent held back is
+#: range lost where the estimates are right (0.9 cost c101 4 % distance, r101 a van).
+BATTERY_MARGIN = 0.98
 #: Searches at most (the first, then again after routes the simulation refused for their
 #: battery), the first's share of the work, and how many times what a route fell below its
 #: reserve its kind of van's battery is made smaller after.
@@ -264,8 +267,9 @@ def charging_routes(
     minimize_vehicles: bool,
     effort: Effort,
 ) -> Charging:
-    """The fleet's routes with charging (module docstring), from ``routes`` (stops per van,
-    a 0 a return to reload) found without. A route whose simulation runs below its reserve
+    """The fleet's routes with charging (module docstring): from the search's own start when
+    every van leaves the depot, else from ``routes`` (stops per van, a 0 a return to reload)
+    found without. A route whose simulation runs below its reserve
     makes its kind of van's battery (and its charge at departure) smaller in the search by what
     the simulation fell below the reserve, :data:`TIGHTEN_MARGIN` times, and the search starts
     again from ``routes`` (which hold without charging; the routes it found may not hold with
@@ -273,7 +277,11 @@ def charging_routes(
     :data:`CHARGING_ROUNDS` times; the best verified routes are kept."""
     charging = charging_instance(day, times_s, minimize_vehicles)
     kind_of = {v: k for k, vans in enumerate(charging.vans_of) for v in vans}
-    initial = [(kind_of[v], [p for p in route if p]) for v, route in enumerate(routes) if route]
+    initial: list[tuple[int, list[int]]] | None = [
+        (kind_of[v], [p for p in route if p]) for v, route in enumerate(routes) if route
+    ]
+    if all(kind.start == 0 for kind in charging.instance.kinds):
+        initial = None  # the search's own start sees the charging time (rc201: −5 % distance)
     best: Charging | None = None
     ends: list[SearchEnd] = []
     for round_ in range(CHARGING_ROUNDS):

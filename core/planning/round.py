@@ -132,18 +132,23 @@ def plan(
     )
     solved = _how_solved(tour, result, scene.places, tours.ends)
     warnings = [*result.warnings, *cut_short(solved.stopped_by)]
-    result = replace(result, solved=solved, warnings=warnings)
-    if result.late_stops:  # the client's own order misses a window
-        late = result.late_stops[0]
-        index = next(k for k, stop in enumerate(problem.stops) if stop.id == late)
-        arrival = next(s.arrival for s in result.stops if s.id == late)
-        raise InvalidStopsError(
-            f"in the given order the van reaches '{late}' at {arrival:%H:%M}, after its last "
-            "time window closes; change the order or let the planner choose it (keep_order "
-            "false)",
-            f"stops[{index}].time_windows",
-        )
-    return result
+    return _in_time(problem, replace(result, solved=solved, warnings=warnings))
+
+
+def _in_time(problem: PlanProblem, result: PlanResult) -> PlanResult:
+    """``result`` when it serves every stop in a window; else the client's own order misses
+    one (the planner's never do): an error naming the first stop it misses."""
+    if not result.late_stops:
+        return result
+    late = result.late_stops[0]
+    index = next(k for k, stop in enumerate(problem.stops) if stop.id == late)
+    arrival = next(s.arrival for s in result.stops if s.id == late)
+    raise InvalidStopsError(
+        f"in the given order the van reaches '{late}' at {arrival:%H:%M}, after its last "
+        "time window closes; change the order or let the planner choose it (keep_order "
+        "false)",
+        f"stops[{index}].time_windows",
+    )
 
 
 def _how_solved(

@@ -210,20 +210,11 @@ def scenario_grid(
     check_seasons(problem, seasons)
     remembering = None if router is None else RememberingRouter(router)
     baseline = plan(problem, remembering, weather_service)
-    n_cells = len(seasons) * len(drivers) * len(traffic)
-    cells_s = baseline.duration_s * n_cells
-    if max_simulated_s is not None and cells_s > max_simulated_s:
-        raise TooMuchToWaitForError(
-            f"{n_cells} cells of a {baseline.duration_s / 3600:,.1f} h round simulate "
-            f"{cells_s / 86_400:,.0f} days; a synchronous study simulates at most "
-            f"{max_simulated_s / 86_400:,.0f}: fewer cells, or submit it as a job "
-            "(POST /v1/jobs, type scenarios)",
-            "seasons",
-        )
+    _check_cells(baseline, len(seasons) * len(drivers) * len(traffic), max_simulated_s)
     by_id = {stop.id: stop for stop in problem.stops}
     fixed = problem.model_copy(
-        update={
-            "stops": [by_id[i] for i in baseline.tour[1:-1]],
+        update={  # the stops in the baseline's order (its tour has the depot and chargers too)
+            "stops": [by_id[i] for i in baseline.tour if i in by_id],
             "keep_order": True,
             "matrix": _reordered_matrix(problem, baseline),
         }
@@ -247,6 +238,19 @@ def scenario_grid(
         if progress is not None:
             progress(done, len(combos))
     return ScenarioGrid(baseline.tour, baseline.energy_kwh, cells)
+
+
+def _check_cells(baseline: PlanResult, n_cells: int, max_simulated_s: float | None) -> None:
+    """Refuse a grid whose cells together simulate more than ``max_simulated_s`` [s]."""
+    cells_s = baseline.duration_s * n_cells
+    if max_simulated_s is not None and cells_s > max_simulated_s:
+        raise TooMuchToWaitForError(
+            f"{n_cells} cells of a {baseline.duration_s / 3600:,.1f} h round simulate "
+            f"{cells_s / 86_400:,.0f} days; a synchronous study simulates at most "
+            f"{max_simulated_s / 86_400:,.0f}: fewer cells, or submit it as a job "
+            "(POST /v1/jobs, type scenarios)",
+            "seasons",
+        )
 
 
 def check_seasons(problem: PlanProblem, seasons: Sequence[Season]) -> None:

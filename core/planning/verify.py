@@ -104,21 +104,7 @@ def simulate_route(
             timeline = laid_out(start, windows_s)
     check_representable(start, timeline.duration_s, "date")
     weather, warnings = scene.weather_for(start, timeline.duration_s)
-    back = at(start, timeline.duration_s)
-    if back.date() > start.date():
-        days = (back.date() - start.date()).days
-        warnings = [
-            *warnings,
-            f"the round ends on {back:%Y-%m-%d} at {back:%H:%M}, {days} day{'s' * (days > 1)} "
-            "after it starts: its drives, services, waits, charges and breaks take that long",
-        ]
-    if timeline.capped_s > 0:
-        cap_kw = (problem.van.vehicle.max_motor_power_w or 0.0) / 1000
-        warnings = [
-            *warnings,
-            f"the motor's {cap_kw:g} kW cap makes the van slower than the traffic: the drives "
-            f"take {timeline.capped_s / 60:,.1f} min longer in all (the times include it)",
-        ]
+    warnings = [*warnings, *_long_day(problem, start, timeline)]
     result = simulate(
         timeline.speed,
         PLAN_DT_S,
@@ -136,6 +122,26 @@ def simulate_route(
     )
     timeline = timeline.driven(result.sample_at)
     return _Split(problem, scene, order, result, timeline, start).result(solved, warnings)
+
+
+def _long_day(problem: PlanProblem, start: dt.datetime, timeline: Timeline) -> list[str]:
+    """What the answer must say of a day that ends on a later date, or that the motor's
+    power cap makes slower than the traffic."""
+    warnings = []
+    back = at(start, timeline.duration_s)
+    if back.date() > start.date():
+        days = (back.date() - start.date()).days
+        warnings.append(
+            f"the round ends on {back:%Y-%m-%d} at {back:%H:%M}, {days} day{'s' * (days > 1)} "
+            "after it starts: its drives, services, waits, charges and breaks take that long"
+        )
+    if timeline.capped_s > 0:
+        cap_kw = (problem.van.vehicle.max_motor_power_w or 0.0) / 1000
+        warnings.append(
+            f"the motor's {cap_kw:g} kW cap makes the van slower than the traffic: the drives "
+            f"take {timeline.capped_s / 60:,.1f} min longer in all (the times include it)"
+        )
+    return warnings
 
 
 class _Split:

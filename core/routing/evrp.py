@@ -189,6 +189,8 @@ def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
     charge = float(np.mean(instance.charge_time[stations])) * CHARGE_TIME_SHARE
     arc_time = instance.duration[arcs] + charge * instance.kinds[0].energy[arcs]
     duration = np.rint(arc_time * _SCALE).astype(np.int64)
+    for matrix in (distance, duration):  # staying put: an energy per arc may count a stop's
+        np.fill_diagonal(matrix, 0)  # service on every arc out of it, the way back to itself too
     clients = [
         pyvrp.Client(
             location=k,
@@ -231,31 +233,20 @@ def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
     ]
 
 
-class _Search:
-    """The routes (kind, customers) and what each costs with its stations (memoised), at the
-    current ``penalty`` per unit of time late (infinite: routes must keep their windows)."""
+class _Priced:
+    """What each route (kind, customers) costs with its stations, memoised, at the current
+    ``penalty`` per unit of time late (infinite: routes must keep their windows); the
+    evaluations and their sizes, the work they stand for."""
 
-    def __init__(self, instance: EvrpInstance, rng: np.random.Generator) -> None:
+    def __init__(self, instance: EvrpInstance) -> None:
         self.instance = instance
-        self.rng = rng
-        self.routes: Routes = []
-        self.left: list[int] = []
         self.penalty = math.inf
         self.evaluations = 0
-        self.moves = 0
         self.squares = 0
-        self.best: tuple[tuple[int, int, float], Routes, list[int]] | None = None
         self.memo: dict[tuple[float, int, tuple[int, ...]], Charged] = {}
-        inst = instance
-        self.facts = [_facts(inst, kind) for kind in inst.kinds]
-        self.candidates = station_candidates(inst.distance, np.array(inst.stations, np.int64))
-        self.nearest = np.argsort(
-            inst.distance[np.ix_(inst.customers, inst.customers)], axis=1, kind="stable"
-        )
-        self.near = {
-            c: {inst.customers[k] for k in self.nearest[n][1 : NEIGHBOURS + 1]}
-            for n, c in enumerate(inst.customers)
-        }
+        self.facts = [_facts(instance, kind) for kind in instance.kinds]
+        stations = np.array(instance.stations, np.int64)
+        self.candidates = station_candidates(instance.distance, stations)
 
     def charged(self, kind: int, route: list[int]) -> Charged:
         key = (self.penalty, kind, tuple(route))
@@ -284,6 +275,30 @@ class _Search:
         """The route's cost with its stations and its penalised lateness; infinite when it
         cannot hold."""
         return self.charged(kind, route).cost(self.penalty)
+
+
+class _Search:
+    """The routes (kind, customers) and the customers left out, searched on their prices
+    (:class:`_Priced`)."""
+
+    def __init__(self, instance: EvrpInstance, rng: np.random.Generator) -> None:
+        self.instance = instance
+        self.rng = rng
+        self.routes: Routes = []
+        self.left: list[int] = []
+        self.priced = _Priced(instance)
+        self.charged = self.priced.charged
+        self.cost = self.priced.cost
+        self.moves = 0
+        self.best: tuple[tuple[int, int, float], Routes, list[int]] | None = None
+        inst = instance
+        self.nearest = np.argsort(
+            inst.distance[np.ix_(inst.customers, inst.customers)], axis=1, kind="stable"
+        )
+        self.near = {
+            c: {inst.customers[k] for k in self.nearest[n][1 : NEIGHBOURS + 1]}
+            for n, c in enumerate(inst.customers)
+        }
 
     def late(self) -> float:
         return sum(self.charged(k, r).warp for k, r in self.routes)
@@ -385,7 +400,8 @@ class _Search:
     @property
     def spent_s(self) -> float:
         """The work done [reference s]: route evaluations by their size, and moves."""
-        return EVALUATION_S * self.evaluations + SQUARE_S * self.squares + MOVE_S * self.moves
+        priced = self.priced
+        return EVALUATION_S * priced.evaluations + SQUARE_S * priced.squares + MOVE_S * self.moves
 
     def improve(self, work_s: float, effort: Effort) -> SearchEnd:
         """Step 3 for ``work_s`` [reference s], capped by ``effort``'s deadline:
@@ -445,14 +461,14 @@ class _Search:
         saved = self._saved()
         order = sorted(range(len(self.routes)), key=lambda r: len(self.routes[r][1]))
         _, out = self.routes.pop(order[nth % len(order)])
-        self.penalty = LATE_PENALTY
+        self.priced.penalty = LATE_PENALTY
         if not all(self.insert(c, allow_new=False) for c in out):
-            (self.routes, self.left), self.penalty = saved, math.inf
+            (self.routes, self.left), self.priced.penalty = saved, math.inf
             return False
         while self.late() > 1e-9 and self.spent_s < until and not effort.out_of_time():
             self._ruin_and_recreate(0.0, late_first=True)
         holds = self.late() <= 1e-9
-        self.penalty = math.inf
+        self.priced.penalty = math.inf
         if not holds or not self.holds():
             self.routes, self.left = saved
             return False
@@ -490,7 +506,7 @@ class _Search:
             self.routes, self.left = saved
 
     def solution(self, ended: SearchEnd) -> EvrpSolution:
-        self.penalty = math.inf
+        self.priced.penalty = math.inf
         if self.best is not None and self.best[0] < self.total():
             _, self.routes, self.left = self.best
         routes = [EvrpRoute(k, self.charged(k, r).visits) for k, r in self.routes]

@@ -131,6 +131,20 @@ def test_grid_cells_agree_with_single_plans():
         )
 
 
+def test_a_grid_of_a_round_that_reloads_keeps_its_trips():
+    """A round of 8 × 40 kg on a 200 kg van reloads once: every cell drives the baseline's
+    trips (its tour lists the depot between them, which is no stop of the round)."""
+    problem = _round()
+    heavy = problem.model_copy(
+        update={"van": problem.van.model_copy(update={"payload_kg": 200.0}), "max_trips": 2}
+    )
+    grid = scenario_grid(heavy, None, [0.5], [0.3])
+    assert grid.tour.count(heavy.depot.id) == 3
+    assert len(grid.cells) == 2  # winter and summer
+    for cell in grid.cells:
+        assert cell.energy_kwh["total"] > 0
+
+
 def test_default_axes_and_the_papers_directions():
     grid = scenario_grid(_round())
     assert len(grid.cells) == 2 * 3 * 2  # winter/summer × calm/normal/aggressive × light/heavy

@@ -19,7 +19,7 @@ import pytest
 
 from benchmarks.evrptw import FOLDER, check, read
 from core.routing.effort import Effort
-from core.routing.evrp import EvrpInstance, VehicleKind, _Search, solve_evrptw
+from core.routing.evrp import EvrpInstance, VehicleKind, _Priced, solve_evrptw
 from core.routing.stations import NO_ROUTE
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -63,9 +63,9 @@ def on_a_line(**changes) -> EvrpInstance:
 
 
 def charged(inst: EvrpInstance, route: list[int], penalty: float = math.inf):
-    search = _Search(inst, np.random.default_rng(0))
-    search.penalty = penalty
-    return search.charged(0, route)
+    priced = _Priced(inst)
+    priced.penalty = penalty
+    return priced.charged(0, route)
 
 
 def test_a_route_on_a_line_charges_what_the_way_to_the_next_charge_takes():

@@ -1,0 +1,379 @@
+"""Fleets that must charge, through the product: Schneider, Stenger & Goeke's six E-VRPTW
+instances sent as fleet plans — in process through the entry point ``POST /v1/fleet-plans``
+calls (:func:`app.operations.fleet_plan.run_fleet_plan`) and over HTTP to the real service —
+every answer replayed by the instance's own rules and set beside the best known; and the Vienna
+day of the issue (80 stops, 30 °C, 30 kWh reefer vans, a 22 kW depot charger and two 150 kW
+chargers) beside the same fleet without chargers and with batteries that never bind.
+
+An instance as a day: one distance unit is ``s`` km and one time unit ``s`` minutes (60 km/h),
+``s`` = min(1, the day's minutes / the horizon); windows rounded inwards to whole minutes; the
+instance's distances and times sent as the client's matrix, the stations' rows after the stops
+(each station a charger of many points, no plug-in time). The van's energy is linear in
+distance: no drag worth the name, every braking recovered, no standing loads (the box at the
+ambient temperature, no cab air-conditioning, no auxiliaries), a flat charging curve; its energy
+per km ``e`` is measured on the product, its battery holds the instance's range (Q / r units of
+distance) at ``e``, and its chargers' power makes the product's charge time per energy the
+instance's ``g``. The replay drives each answer's tour by the instance's rules (energy r ×
+distance, charge time g × energy, a charge never beyond a full battery): a van of the product
+never uses less energy than the instance's, so what the product plans holds there.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import httpx
+import numpy as np
+
+from benchmarks.common import Server, print_table, vienna_stops
+from benchmarks.evrptw import FOLDER, Instance, best_known, read
+
+#: The time limit of each plan [s] (``COLDROUTE_BENCH_EVRPTW_S`` shortens it).
+BUDGET_S = float(os.environ.get("COLDROUTE_BENCH_EVRPTW_S", "60"))
+#: The last minute of the day a shift may end at.
+DAY_END_MIN = 1439
+#: Kilograms per unit of the instance's demand: light, so the van's mass hardly changes.
+KG_PER_UNIT = 0.1
+#: The work sent per second of the time limit [reference s] (by default a request's work is a
+#: tenth of its limit): the whole limit's worth, which these instances spend in 10–57 s here.
+WORK_PER_LIMIT = 1.0
+#: Vans offered beyond the best known's.
+SPARE_VANS = 4
+#: Slack of the replay on times and energy (the windows are whole minutes).
+TOLERANCE = 1e-6
+#: The van whose energy is linear in distance (module docstring).
+LINEAR_VAN: dict[str, Any] = {
+    "vehicle": {
+        "preset": "paper-generic",
+        "drag_coefficient": 0.05,
+        "air_density_kg_m3": 0.5,
+        "drivetrain_efficiency": 1.0,
+        "regen_efficiency": 1.0,
+        "max_regen_deceleration_mps2": 10.0,
+        "auxiliaries_power_w": 0.0,
+        "cabin_hvac_enabled": False,
+    },
+    "cargo_box": {
+        "setpoint_c": 20.0,
+        "product_limit_c": 25.0,
+        "standby_power_w": 0.0,
+        "solar_absorptivity": 0.0,
+    },
+}
+AMBIENT = {"t_min_c": 20, "t_max_c": 20}
+
+
+@dataclass(frozen=True)
+class Scaled:
+    """An instance as a day: its km and minutes per unit, r, Q, g and the van's energy per
+    unit of distance [kWh]."""
+
+    instance: Instance
+    unit: float
+    kwh_per_unit: float
+
+    @property
+    def kind(self) -> Any:
+        return self.instance.problem.kinds[0]
+
+    @property
+    def r(self) -> float:
+        d = self.instance.problem.distance
+        i, j = np.unravel_index(np.argmax(d), d.shape)
+        return float(self.kind.energy[i, j] / d[i, j])
+
+    @property
+    def kwh_per_energy(self) -> float:
+        """One of the instance's units of energy [kWh]."""
+        return self.kwh_per_unit / self.r
+
+
+def clock(minutes: float) -> str:
+    return f"{int(minutes) // 60:02d}:{int(minutes) % 60:02d}"
+
+
+def scaled(instance: Instance, kwh_per_km: float) -> Scaled:
+    unit = min(1.0, DAY_END_MIN / float(instance.problem.due[0]))
+    return Scaled(instance, unit, kwh_per_km * unit)
+
+
+def fleet_request(day: Scaled, time_limit_s: float) -> dict[str, Any]:
+    """The instance as the JSON body of ``POST /v1/fleet-plans`` (module docstring)."""
+    problem, ids, xy = day.instance.problem, day.instance.ids, day.instance.xy
+    g = float(problem.charge_time[problem.stations[0]])
+    power_kw = day.kwh_per_energy / (g * day.unit / 60.0)
+    battery = {
+        "usable_capacity_kwh": day.kind.battery * day.kwh_per_energy,
+        "initial_soc": 1.0,
+        "min_soc": 0.0,
+        "temperature_derating": False,
+        "charging_efficiency": 1.0,
+        "max_charge_power_kw": min(power_kw * 2, 1000.0),
+        "charging_curve": [{"soc": 0.0, "power_kw": power_kw}, {"soc": 1.0, "power_kw": power_kw}],
+    }
+
+    def where(k: int) -> dict[str, float]:
+        dx, dy = (xy[k] - xy[0]) * day.unit * 1000.0
+        return {"lat": 48.0 + dy / 111_000, "lon": 16.0 + dx / 74_000}
+
+    def window(k: int) -> tuple[int, int]:
+        a, b = problem.ready[k] * day.unit, problem.due[k] * day.unit
+        return math.ceil(a - 1e-9), min(math.floor(b + 1e-9), DAY_END_MIN)
+
+    vans = best_known()[day.instance.name][0] + SPARE_VANS
+    return {
+        "date": "2026-04-15",
+        "timezone": "UTC",
+        "depot": {"id": ids[0], **where(0)},
+        "vehicles": [
+            LINEAR_VAN
+            | {
+                "id": f"v{k}",
+                "battery": battery,
+                "payload_kg": day.kind.capacity * KG_PER_UNIT,
+                "shift_start": "00:00",
+                "shift_end": clock(window(0)[1]),
+                "breaks": "none",
+            }
+            for k in range(vans)
+        ],
+        "stops": [
+            {
+                "id": ids[k],
+                **where(k),
+                "delivery_kg": float(problem.demand[k]) * KG_PER_UNIT,
+                "service_time_s": float(problem.service[k]) * day.unit * 60.0,
+                "door_open_s": 0.0,
+                "time_windows": [{"start": clock(window(k)[0]), "end": clock(window(k)[1])}],
+            }
+            for k in problem.customers
+        ],
+        "chargers": [
+            {"id": ids[k], **where(k), "power_kw": power_kw, "points": 50, "plug_minutes": 0}
+            for k in problem.stations
+        ],
+        "matrix": {
+            "distances_m": (problem.distance * day.unit * 1000.0).tolist(),
+            "durations_s": (problem.duration * day.unit * 60.0).tolist(),
+        },
+        "weather": AMBIENT,
+        "objective": "distance",
+        "minimize_vehicles": True,
+        "time_limit_s": time_limit_s,
+        "work_s": WORK_PER_LIMIT * time_limit_s,
+    }
+
+
+def replay(day: Scaled, answer: dict[str, Any]) -> tuple[float, str | None]:
+    """The answer's routes driven by the instance's rules: their distance [units] and what
+    they break, or None."""
+    problem = day.instance.problem
+    index = {place: k for k, place in enumerate(day.instance.ids)}
+    kind, total, seen = day.kind, 0.0, []
+    for route in answer["routes"]:
+        charged = {c["arrive"]: c["battery_kwh"] / day.kwh_per_energy for c in route["charges"]}
+        battery, clock_u, place = kind.battery, float(problem.ready[0]), 0
+        for name, leg in zip(route["tour"][1:], route["legs"], strict=True):
+            j = index[name]
+            battery -= kind.energy[place, j]
+            total += problem.distance[place, j]
+            clock_u += problem.duration[place, j]
+            if battery < -TOLERANCE * kind.battery:
+                return total, f"{route['vehicle_id']} runs empty before {name}"
+            if clock_u > problem.due[j] + TOLERANCE:
+                return total, f"{route['vehicle_id']} reaches {name} after its window"
+            clock_u = max(clock_u, problem.ready[j]) + problem.service[j]
+            if j in problem.stations:
+                charge = min(charged.get(leg["arrive"], 0.0), kind.battery - battery)
+                battery += charge
+                clock_u += problem.charge_time[j] * charge
+            elif j:
+                seen.append(j)
+            place = j
+    if len(seen) != len(set(seen)):
+        return total, "a customer is served twice"
+    return total, None
+
+
+def linear_kwh_per_km(plan: Any) -> tuple[float, float]:
+    """The linear van's energy per km empty (the least it draws) on a 20 km leg there and
+    back, and how far from linear
+    it is on a 1 km leg (the ratio of the two per km) — through ``plan`` (a request body to
+    an answer)."""
+    per_km = []
+    for km in (20.0, 1.0):
+        body = {
+            "date": "2026-04-15",
+            "timezone": "UTC",
+            "depot": {"id": "d", "lat": 48.0, "lon": 16.0},
+            "vehicles": [
+                LINEAR_VAN | {"id": "v", "payload_kg": 0, "battery": {"usable_capacity_kwh": 100}}
+            ],
+            "stops": [{"id": "s", "lat": 48.0 + km / 111, "lon": 16.0, "service_time_s": 0}],
+            "matrix": {
+                "distances_m": [[0, km * 1000], [km * 1000, 0]],
+                "durations_s": [[0, km * 60], [km * 60, 0]],
+            },
+            "weather": AMBIENT,
+            "time_limit_s": 1,
+        }
+        answer = plan(body)
+        per_km.append(answer["totals"]["energy_kwh"]["total"] / (2 * km))
+    return per_km[0], per_km[1] / per_km[0]
+
+
+def _in_process(body: dict[str, Any]) -> dict[str, Any]:
+    from app.operations.fleet_plan import answer, run_fleet_plan
+    from app.schemas.fleet import FleetPlanRequest
+    from app.settings import Settings
+
+    request = FleetPlanRequest.model_validate(body)
+    return answer(request, run_fleet_plan(request, Settings())).model_dump(mode="json")
+
+
+def _over_http(url: str, timeout_s: float) -> Any:
+    def plan(body: dict[str, Any]) -> dict[str, Any]:
+        response = httpx.post(f"{url}/v1/fleet-plans", json=body, timeout=timeout_s)
+        assert response.status_code == 200, response.text[:500]
+        return dict(response.json())
+
+    return plan
+
+
+def evrptw_tables(budget_s: float = BUDGET_S) -> None:
+    """The six instances through the product: in process and over HTTP."""
+    known = best_known()
+    instances = [read(path) for path in sorted(FOLDER.glob("*_21.txt"))]
+    server = Server({"COLDROUTE_MAX_TIME_LIMIT_S": str(max(budget_s, 60))}).start()
+    try:
+        paths = {"in process": _in_process, "HTTP": _over_http(server.url, budget_s * 4 + 60)}
+        kwh_per_km, short = linear_kwh_per_km(paths["HTTP"])
+        for path, plan in paths.items():
+            rows = []
+            for instance in instances:
+                day = scaled(instance, kwh_per_km)
+                started = time.perf_counter()
+                answer = plan(fleet_request(day, budget_s))
+                wall_s = time.perf_counter() - started
+                distance, broken = replay(day, answer)
+                vans, best = known[instance.name]
+                served = sum(len(route["stops"]) for route in answer["routes"])
+                used = answer["totals"]["vehicles_used"]
+                rows.append(
+                    [
+                        instance.name,
+                        f"{vans} / {best:.1f}",
+                        f"{served}/{len(instance.problem.customers)}",
+                        f"{used} ({used - vans:+d})",
+                        f"{distance:.1f} ({(distance / best - 1) * 100:+.1f} %)",
+                        sum(len(route["charges"]) for route in answer["routes"]),
+                        "yes" if broken is None else f"no: {broken}",
+                        f"{wall_s:.0f}",
+                        answer["solver"]["stopped_by"],
+                    ]
+                )
+            print_table(
+                f"E-VRPTW (Schneider et al. 2014) as fleet plans, {path}, time_limit_s "
+                f"{budget_s:g} (the linear van: {kwh_per_km:.4f} kWh/km; on 1 km legs "
+                f"{short:.3f}× that)",
+                [
+                    "instance",
+                    "best known (vans / distance)",
+                    "served",
+                    "vans",
+                    "distance (vs best known)",
+                    "charges",
+                    "holds by the instance's rules",
+                    "answer [s]",
+                    "stopped_by",
+                ],
+                rows,
+            )
+    finally:
+        server.close()
+
+
+def vienna_day(chargers: bool, battery_kwh: float, budget_s: float) -> dict[str, Any]:
+    """The issue's Vienna day: 80 stops within 30 km, 30 °C, ten ``ev-van-3.5t-reefer`` with
+    ``battery_kwh``; with ``chargers`` a 22 kW depot charger and two 150 kW ones."""
+    rng = np.random.default_rng(29)
+    stops = vienna_stops(rng, 80, 300.0, 90.0, 10.0, spread_deg=(0.2, 0.3))
+    depot: dict[str, Any] = {"id": "depot", "lat": 48.21, "lon": 16.37}
+    body: dict[str, Any] = {
+        "date": "2026-07-15",
+        "timezone": "Europe/Vienna",
+        "depot": depot,
+        "vehicles": [
+            {
+                "id": f"van-{k + 1}",
+                "vehicle": {"preset": "ev-van-3.5t-reefer"},
+                "battery": {"usable_capacity_kwh": battery_kwh, "min_soc": 0.1},
+                "shift_start": "06:00",
+                "shift_end": "18:00",
+            }
+            for k in range(10)
+        ],
+        "stops": stops,
+        "weather": {"t_min_c": 30, "t_max_c": 30},
+        "objective": "distance",
+        "minimize_vehicles": True,
+        "time_limit_s": budget_s,
+        "work_s": WORK_PER_LIMIT * budget_s,
+    }
+    if chargers:
+        body["depot"] = depot | {"charger": {"power_kw": 22, "points": 2}}
+        body["chargers"] = [
+            {"id": "hpc-north", "lat": 48.30, "lon": 16.40, "power_kw": 150, "points": 2},
+            {"id": "hpc-south", "lat": 48.12, "lon": 16.33, "power_kw": 150, "points": 2},
+        ]
+    return body
+
+
+def vienna_table(budget_s: float = 30.0) -> None:
+    """The Vienna day with chargers beside the same fleet without and with batteries that
+    never bind, over HTTP."""
+    rows = []
+    with_server = Server({"COLDROUTE_MAX_TIME_LIMIT_S": str(max(budget_s, 60))}).start()
+    try:
+        plan = _over_http(with_server.url, budget_s * 4 + 60)
+        answers = {
+            "30 kWh, chargers": plan(vienna_day(True, 30.0, budget_s)),
+            "30 kWh, no charger": plan(vienna_day(False, 30.0, budget_s)),
+            "never binding (500 kWh)": plan(vienna_day(False, 500.0, budget_s)),
+        }
+    finally:
+        with_server.close()
+    free = answers["never binding (500 kWh)"]["totals"]["distance_m"]
+    for name, answer in answers.items():
+        rows.append(
+            [
+                name,
+                sum(len(route["stops"]) for route in answer["routes"]),
+                answer["totals"]["vehicles_used"],
+                f"{answer['totals']['distance_m'] / 1000:.1f}",
+                f"{(answer['totals']['distance_m'] / free - 1) * 100:+.1f} %",
+                sum(len(route["charges"]) for route in answer["routes"]),
+            ]
+        )
+    print_table(
+        f"The Vienna day (80 stops within ~30 km, 30 °C, ev-van-3.5t-reefer) over HTTP at "
+        f"time_limit_s {budget_s:g}",
+        ["fleet", "served", "vans", "distance [km]", "vs never binding", "charges"],
+        rows,
+    )
+
+
+def main() -> None:
+    evrptw_tables()
+    vienna_table()
+
+
+if __name__ == "__main__":
+    if os.environ.get("COLDROUTE_BENCH_ONLY") == "vienna":
+        vienna_table()
+    else:
+        main()
