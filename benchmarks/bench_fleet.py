@@ -14,9 +14,9 @@ import numpy as np
 
 from benchmarks.common import REFERENCE, print_table, pyvrp_vrptw
 from core.params import PRESETS, BatteryParams, Depot, RoadMatrix, Stop, TimeWindow, Weather
-from core.planning.fleet import FIRST_SOLVE_SHARE, plan_fleet
+from core.planning.fleet.planner import FIRST_SOLVE_SHARE, plan_fleet
 from core.planning.model import FleetProblem, FleetResult, FleetVehicle, PlanProblem
-from core.planning.round import plan
+from core.planning.round.planner import plan
 
 #: Solomon's instances as a city: one distance unit is ``UNIT_KM[name]`` km and the same time
 #: unit that many minutes (60 km/h, the literature's travel time = distance), so the horizon

@@ -243,7 +243,8 @@ def profile_table(name: str = "R1_10_1") -> None:
     from app.operations.fleet_plan import answer, fleet_problem
     from app.schemas.fleet import FleetPlanRequest
     from app.settings import Settings
-    from core.planning import day, fleet
+    from core.planning.fleet import planner as fleet
+    from core.planning.search import day
 
     stages = _Stages()
     stages.wrap(fleet, "legs_for", "matrix (checked, legs)")

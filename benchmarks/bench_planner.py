@@ -14,7 +14,7 @@ import numpy as np
 from benchmarks.common import REFERENCE, busy_core, euc_2d_matrix, print_table
 from core.params import Depot, Stop
 from core.planning.model import PLAN_TIME_LIMIT_S, WORK_SHARE, PlanProblem
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from core.routing.effort import Effort
 from core.routing.tsp import solve_tour, tour_cost
 from tests.utils.rounds import Round, clustered_round, uniform_round

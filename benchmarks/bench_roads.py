@@ -16,7 +16,7 @@ from app.connectors.osrm import OsrmRouter
 from benchmarks.common import REFERENCE, print_table
 from core.params import Depot, RoadMatrix, Stop, Weather
 from core.planning.model import PlanProblem
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from core.routing.roads import LegRoute, RoadTable
 from tools import osrm
 

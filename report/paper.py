@@ -38,7 +38,7 @@ from core.params import (
 from core.physics.cycles import generate_leg
 from core.physics.simulate import CONSUMERS, simulate
 from core.planning.model import PlanProblem, PlanResult
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from core.planning.studies import Season, scenario_grid, speed_sweep
 
 COLORS = {

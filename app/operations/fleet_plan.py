@@ -18,7 +18,7 @@ from app.schemas.fleet import (
 )
 from app.settings import Settings
 from core.exceptions import CoreError
-from core.planning.fleet import check_fleet, plan_fleet
+from core.planning.fleet.planner import check_fleet, plan_fleet
 from core.planning.model import (
     FleetFields,
     FleetProblem,

@@ -25,7 +25,7 @@ from app.schemas.plans import (
 )
 from app.settings import Settings
 from core.planning.model import DayProfile, PlanFields, PlanProblem, PlanResult, fields_of
-from core.planning.round import check, plan
+from core.planning.round.planner import check, plan
 
 
 def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:

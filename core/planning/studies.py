@@ -29,7 +29,7 @@ from core.physics.cycles import generate_leg
 from core.physics.simulate import CONSUMERS, MAX_SPEED_MPS, simulate
 from core.physics.weather import WeatherService
 from core.planning.model import PlanProblem, PlanResult
-from core.planning.round import plan, round_start
+from core.planning.round.planner import plan, round_start
 from core.routing.roads import RememberingRouter, RoadRouter
 
 #: Shortest swept trip [m]: shorter ones are all ramp and say nothing about a cruising speed.
@@ -190,7 +190,7 @@ def scenario_grid(
     progress
         Called with (cells done, cells in all) after each cell.
     router, weather_service
-        As for :func:`core.planning.round.plan`; the router is asked once per leg for the
+        As for :func:`core.planning.round.planner.plan`; the router is asked once per leg for the
         whole grid. A season with its own weather keeps it; the others get the service's
         forecast.
     max_simulated_s

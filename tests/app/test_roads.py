@@ -15,7 +15,7 @@ from app.connectors.osrm import OsrmRouter
 from app.examples import SCENARIOS_EXAMPLE
 from core.exceptions import NoRouteError
 from core.params import Place
-from core.planning.day import leg_roads
+from core.planning.search.day import leg_roads
 from tests.app.apps import app_client
 from tools import osrm
 

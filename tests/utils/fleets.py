@@ -10,10 +10,10 @@ from zoneinfo import ZoneInfo
 import numpy as np
 
 from core.params import PRESETS, Depot, RoadMatrix, Stop, TimeWindow, Weather
-from core.planning.day import FleetDay, fleet_day
-from core.planning.fleet import check_fleet
+from core.planning.day.scene import Scene, legs_for
+from core.planning.fleet.planner import check_fleet
 from core.planning.model import FleetProblem, FleetVehicle
-from core.planning.scene import Scene, legs_for
+from core.planning.search.day import FleetDay, fleet_day
 
 VIENNA = ZoneInfo("Europe/Vienna")
 DAY = dt.date(2026, 7, 15)

@@ -8,9 +8,9 @@ import datetime as dt
 import pytest
 
 from core.exceptions import InvalidParameterError
+from core.planning.day.timeline import EU_BREAK_S, MAX_DRIVING_S
 from core.planning.model import FixedBreak, FleetVehicle
-from core.planning.round import plan
-from core.planning.timeline import EU_BREAK_S, MAX_DRIVING_S
+from core.planning.round.planner import plan
 from tests.core.planning.test_recharge import summer_day
 
 HOUR = dt.timedelta(hours=1)

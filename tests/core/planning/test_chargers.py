@@ -13,9 +13,9 @@ import pytest
 
 from core.exceptions import InvalidMatrixError, InvalidStopsError
 from core.params import Charger, RoadMatrix
+from core.planning.day.recharge import PARTIAL_CHARGE_MARGIN
 from core.planning.model import PlanProblem, PlanResult, StartState
-from core.planning.recharge import PARTIAL_CHARGE_MARGIN
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from tests.core.planning.test_recharge import stretch_lows, summer_day
 
 KWH = 3.6e6

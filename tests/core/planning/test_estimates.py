@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from core.physics.battery import JOULES_PER_KWH
-from core.planning.estimates import LEARNED_RATIO_QUANTILE, LearnedTimes, energy_matrix_j
+from core.planning.day.estimates import LEARNED_RATIO_QUANTILE, LearnedTimes, energy_matrix_j
 from tests.utils.fleets import day_of, fleet, two_clusters, van
 
 

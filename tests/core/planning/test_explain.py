@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from core.params import Stop
-from core.planning.explain import explain
-from core.planning.feasibility import Feasibility
-from core.planning.verify import Failure
+from core.planning.day.verify import Failure
+from core.planning.fleet.explain import explain
+from core.planning.search.feasibility import Feasibility
 from tests.utils.fleets import day_of, fleet, two_clusters, van
 
 

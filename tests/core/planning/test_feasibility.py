@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from core.params import BatteryParams, Stop
-from core.planning.feasibility import Feasibility
+from core.planning.search.feasibility import Feasibility
 from tests.utils.fleets import day_of, fleet, two_clusters, van, window
 
 

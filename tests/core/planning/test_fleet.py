@@ -17,9 +17,9 @@ from core.params import (
     VanParams,
     Weather,
 )
-from core.planning.fleet import plan_fleet
+from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem, FleetResult, FleetVehicle, PlanProblem
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from core.routing.roads import LegRoute, RoadTable
 from tests.utils.fleets import DAY, DEPOT, SUMMER, VAN, at, fleet, two_clusters, van, window
 
@@ -331,7 +331,7 @@ def test_a_stop_the_search_left_out_goes_to_an_idle_van_that_serves_it_alone(mon
     """The trust issue: stops were left out as "time_window" that one of 19 idle vans could
     serve on a round of its own. Whatever the search leaves out (here: it ran out of time
     before placing W3), an idle van that serves the stop alone, by the simulation, takes it."""
-    from core.planning import fleet as fleet_module
+    from core.planning.fleet import planner as fleet_module
     from core.routing.vrp import RoutingOutcome
 
     stops, matrix = two_clusters(time_windows=[window("09:00", "09:20")])
@@ -352,7 +352,7 @@ def test_a_stop_the_search_left_out_goes_to_an_idle_van_that_serves_it_alone(mon
 
 
 def test_a_stop_an_idle_van_cannot_serve_alone_says_what_its_simulation_broke(monkeypatch):
-    from core.planning import fleet as fleet_module
+    from core.planning.fleet import planner as fleet_module
     from core.routing.vrp import RoutingOutcome
 
     stops, matrix = two_clusters(time_windows=[window("09:00", "09:20")])

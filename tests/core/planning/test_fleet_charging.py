@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop
-from core.planning.fleet import plan_fleet
-from core.planning.fleet_charging import Bookings
+from core.planning.charging.fleet_charging import Bookings
+from core.planning.day.timeline import MAX_DRIVING_S
+from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
-from core.planning.timeline import MAX_DRIVING_S
 from tests.core.planning.test_breaks import driving_between_breaks_s
 from tests.core.planning.test_recharge import summer_day
 

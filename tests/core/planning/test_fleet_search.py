@@ -8,7 +8,7 @@ from collections import Counter
 import pytest
 
 from benchmarks.bench_fleet import pyvrp_solomon, solomon, solomon_problem, vienna_grid
-from core.planning.fleet import plan_fleet
+from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem
 
 

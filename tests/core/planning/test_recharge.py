@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from core.params import PRESETS, BatteryParams, ChargePoint, Depot, Stop, TimeWindow, Weather
+from core.planning.day.recharge import PARTIAL_CHARGE_MARGIN
 from core.planning.model import PlanProblem, PlanResult
-from core.planning.recharge import PARTIAL_CHARGE_MARGIN
-from core.planning.round import plan
+from core.planning.round.planner import plan
 
 KWH = 3.6e6
 

@@ -11,9 +11,9 @@ import pytest
 
 from core.exceptions import InvalidParameterError, InvalidStopsError
 from core.params import ChargePoint, TimeWindow
-from core.planning.fleet import plan_fleet
+from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from tests.core.planning.test_recharge import summer_day
 
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.planning.feasibility import Feasibility
-from core.planning.repair import costliest, fitting, repair
-from core.planning.verify import Failure
+from core.planning.day.verify import Failure
+from core.planning.search.feasibility import Feasibility
+from core.planning.search.repair import costliest, fitting, repair
 from tests.utils.fleets import day_of, fleet, two_clusters, van
 
 

@@ -18,7 +18,7 @@ from core.params import (
 )
 from core.physics.weather import climatology
 from core.planning.model import PlanProblem
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from core.routing.geo import build_legs
 
 DEPOT = Depot(id="depot", lat=48.2082, lon=16.3738)

@@ -18,7 +18,7 @@ from core.params import (
 from core.physics.cycles import generate_leg, trace_distance_m
 from core.physics.simulate import MAX_SPEED_MPS
 from core.planning.model import PlanProblem
-from core.planning.round import plan
+from core.planning.round.planner import plan
 from core.planning.studies import Season, scenario_grid, speed_sweep, sweep_street
 
 NOON = dt.datetime(2026, 7, 15, 12, tzinfo=ZoneInfo("Europe/Vienna"))

@@ -10,7 +10,7 @@ from zoneinfo import ZoneInfo
 import pytest
 
 from core.params import Stop, TimeWindow
-from core.planning.timeline import build_timeline, later_departure_s, next_window, windows_after
+from core.planning.day.timeline import build_timeline, later_departure_s, next_window, windows_after
 from tests.utils.fleets import DEPOT, day_of, fleet, two_clusters, van
 
 

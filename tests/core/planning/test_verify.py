@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from core.params import BatteryParams
-from core.planning.verify import route_failure
+from core.planning.day.verify import route_failure
 from tests.utils.fleets import at, day_of, fleet, two_clusters, van, window
 
 

@@ -8,7 +8,7 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    charge), each arc's cost on the objective, its driving time (the times the simulation
    taught the search) and, per kind of van, its energy (traction by the arc's grade for the
    van's mass, the standing loads by its duration, each stop's service and door openings at
-   its origin: :mod:`core.planning.estimates`); each van kind's battery between its reserve
+   its origin: :mod:`core.planning.day.estimates`); each van kind's battery between its reserve
    and full, what it holds at departure, its payload, its shift and where it sets off; each
    charger's charge time per joule (the van's charging curve at the charger's power, reserve
    to 80 %) and its plug-in time; each stop's window (the first opening to the last close).
@@ -17,10 +17,10 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    search found without charging (the stops left out inserted where they cost least), and
    serves every stop it can, then fewest vans (when asked), then the objective.
 3. **Verification**: each route is simulated with its charges fitted to what the simulation
-   says each stretch takes (:func:`core.planning.recharge.with_charges`), the charge points
+   says each stretch takes (:func:`core.planning.day.recharge.with_charges`), the charge points
    free only between the other vans' charges (:class:`Bookings`). A route the simulation
    refuses loses the stop it names, else the costliest, until it holds
-   (:func:`core.planning.repair.repair`).
+   (:func:`core.planning.search.repair.repair`).
 
 The fleet keeps whichever serves more stops — then fewer vans when asked, then the lower
 objective — of the routes without charging and these.
@@ -38,14 +38,14 @@ import numpy as np
 from core.params import ChargePoint
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, charge_curve
-from core.planning.day import FleetDay, long_where_no_road
-from core.planning.estimates import cost_matrix, energy_matrix_j
+from core.planning.day.estimates import cost_matrix, energy_matrix_j
+from core.planning.day.recharge import Busy
+from core.planning.day.scene import charge_points
+from core.planning.day.timeline import ChargeVisit
+from core.planning.day.verify import Failure, route_failure
 from core.planning.model import DEPOT_CHARGER_ID, PlanResult
-from core.planning.recharge import Busy
-from core.planning.repair import Repaired, repair
-from core.planning.scene import charge_points
-from core.planning.timeline import ChargeVisit
-from core.planning.verify import Failure, route_failure
+from core.planning.search.day import FleetDay, long_where_no_road
+from core.planning.search.repair import Repaired, repair
 from core.routing.effort import Effort, SearchEnd, combined
 from core.routing.evrp import (
     EvrpInstance,
@@ -370,7 +370,7 @@ def _held(
 ) -> tuple[Repaired, PlanResult | None]:
     """Van ``v`` driving ``order`` (its chargers among the stops) with ``charges`` fitted —
     else its stops with the charges the planner places itself
-    (:func:`core.planning.recharge.with_charges`) —, stops taken out until its simulation
+    (:func:`core.planning.day.recharge.with_charges`) —, stops taken out until its simulation
     holds (the chargers stay where they are); and its first simulation when neither held."""
     shift = day.shifts[v]
     busy = bookings.busy(shift.id)

@@ -14,10 +14,10 @@ from numpy.typing import NDArray
 
 from core.clock import at
 from core.physics.battery import JOULES_PER_KWH
-from core.planning.day import FleetDay
+from core.planning.day.timeline import next_window
+from core.planning.day.verify import Failure
 from core.planning.model import UnassignedReason
-from core.planning.timeline import next_window
-from core.planning.verify import Failure
+from core.planning.search.day import FleetDay
 
 
 @dataclass(frozen=True)

@@ -21,8 +21,8 @@ from core.physics.cargo import door_heat_w, refrigeration_cop
 from core.physics.cycles import generate_leg
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate
 from core.physics.vehicle import step_traction_power_w
+from core.planning.day.timeline import PLAN_DT_S
 from core.planning.model import PlanProblem
-from core.planning.timeline import PLAN_DT_S
 from core.routing.geo import MAX_LEG_GRADE, STREET_TYPE_NAMES, Legs
 from core.routing.units import ENERGY_UNIT_J
 

@@ -18,13 +18,13 @@ from core.arrays import FloatArray
 from core.clock import at
 from core.exceptions import NoRouteError
 from core.params import Place
-from core.planning.estimates import VanEstimates, van_estimates
+from core.planning.day.estimates import VanEstimates, van_estimates
+from core.planning.day.recharge import Busy, with_charges
+from core.planning.day.scene import Scene
+from core.planning.day.start_state import start_payload_kg
+from core.planning.day.timeline import ChargeVisit, windows_after
+from core.planning.day.verify import simulate_route
 from core.planning.model import MAX_ROUND_S, PlanProblem, PlanResult, Solved, place_field
-from core.planning.recharge import Busy, with_charges
-from core.planning.scene import Scene
-from core.planning.start_state import start_payload_kg
-from core.planning.timeline import ChargeVisit, windows_after
-from core.planning.verify import simulate_route
 from core.routing.geo import Legs
 from core.routing.roads import LegRoute, RoadRouter
 from core.routing.units import payload_units_down, payload_units_up
@@ -157,7 +157,7 @@ class FleetDay:
     ) -> PlanResult:
         """Van ``v`` driving ``order`` (place indices, the chargers it visits among them) with
         ``charges`` fitted again and more where its battery would not last
-        (:func:`core.planning.recharge.with_charges`): its windows and its shift kept, the
+        (:func:`core.planning.day.recharge.with_charges`): its windows and its shift kept, the
         charge points free when ``busy`` says other vans do not take them all."""
         stops = [place for place in order[1:-1] if place in self.stop_nodes]
         problem, scene, _, start, solved = self._round(v, stops)

@@ -2,12 +2,12 @@
 windows, shifts, payload and the battery as constraints — and every returned route verified by
 the full simulation of its day.
 
-1. The solver (:mod:`core.routing.vrp`) plans with estimates (:mod:`core.planning.estimates`):
+1. The solver (:mod:`core.routing.vrp`) plans with estimates (:mod:`core.planning.day.estimates`):
    each arc's driving time, and its energy as traction by the arc's distance and grade for the
    van's mass plus the standing loads (auxiliaries, cab, box) times its duration, with each
    stop's service and door openings; the usable battery energy between departure charge and
    reserve is the van's budget.
-2. Each route is driven and simulated in full (:mod:`core.planning.verify`: traction,
+2. Each route is driven and simulated in full (:mod:`core.planning.day.verify`: traction,
    auxiliaries, cab, refrigeration with the door openings, at the time of day each leg is
    really driven). A route that breaks a rule — its charge below the reserve, a window missed,
    back after its shift — tightens the estimate that misled the solver (that van's energy
@@ -15,12 +15,12 @@ the full simulation of its day.
    others by the ratio seen) and the fleet is solved again from the routes that held, within
    the time budget.
 3. Whatever still fails when the budget is spent loses stops, one at a time, until its
-   simulation holds (:mod:`core.planning.repair`). A stop no van can serve is listed with its
-   reason (:mod:`core.planning.explain`) — never a route reported feasible that the simulation
+   simulation holds (:mod:`core.planning.search.repair`). A stop no van can serve is listed with its
+   reason (:mod:`core.planning.fleet.explain`) — never a route reported feasible that the simulation
    says is not.
 4. With chargers (the depot's, or on the way) and stops left out for their battery, the
    E-VRPTW search plans the fleet again from these routes with charges between stops, each
-   route verified by its simulation with its charges (:mod:`core.planning.fleet_charging`);
+   route verified by its simulation with its charges (:mod:`core.planning.charging.fleet_charging`);
    the fleet keeps whichever serves more stops (then fewer vans when asked, then the lower
    objective).
 
@@ -42,12 +42,15 @@ from core.exceptions import CoreError, InvalidParameterError, NoRouteError
 from core.params import Place
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import WeatherService, forecast_for
-from core.planning.charge_insertion import serve_with_charging
-from core.planning.day import FleetDay, VanShift, fleet_day, leg_roads
-from core.planning.estimates import LearnedTimes
-from core.planning.explain import explain
-from core.planning.feasibility import Feasibility
-from core.planning.fleet_charging import charging_routes, measure
+from core.planning.charging.charge_insertion import serve_with_charging
+from core.planning.charging.fleet_charging import charging_routes, measure
+from core.planning.day.estimates import LearnedTimes
+from core.planning.day.scene import Scene, legs_for, round_field
+from core.planning.day.start_state import START_ID, check_start, check_start_id, under_way
+from core.planning.day.timeline import client_legs_too_fast, drive_time_s
+from core.planning.day.verify import Failure, route_failure, traced_seconds
+from core.planning.fleet.explain import explain
+from core.planning.fleet.solver_input import routing_input
 from core.planning.model import (
     FleetProblem,
     FleetResult,
@@ -61,12 +64,9 @@ from core.planning.model import (
     cut_short,
     fields_of,
 )
-from core.planning.repair import Repaired, fitting, repair
-from core.planning.scene import Scene, legs_for, round_field
-from core.planning.solver_input import routing_input
-from core.planning.start_state import START_ID, check_start, check_start_id, under_way
-from core.planning.timeline import client_legs_too_fast, drive_time_s
-from core.planning.verify import Failure, route_failure, traced_seconds
+from core.planning.search.day import FleetDay, VanShift, fleet_day, leg_roads
+from core.planning.search.feasibility import Feasibility
+from core.planning.search.repair import Repaired, fitting, repair
 from core.routing.effort import Effort, SearchEnd, combined
 from core.routing.roads import RememberingRouter, RoadRouter
 from core.routing.vrp import solve_routes
@@ -109,9 +109,9 @@ def plan_fleet(
     problem
         The fleet and the day's stops.
     router
-        A road router for the matrix and the roads, as in :func:`core.planning.round.plan`.
+        A road router for the matrix and the roads, as in :func:`core.planning.round.planner.plan`.
     weather_service
-        An hourly forecast for the day, as in :func:`core.planning.round.plan`.
+        An hourly forecast for the day, as in :func:`core.planning.round.planner.plan`.
     """
     started = time.perf_counter()
     effort = problem.effort(problem.time_limit_s)
@@ -451,7 +451,7 @@ def _simulated(
 def _unassigned(
     rules: Feasibility, routes: list[list[int]], left_out: dict[int, Failure]
 ) -> list[Unassigned]:
-    """Each stop no route serves, with why (:func:`core.planning.explain.explain`)."""
+    """Each stop no route serves, with why (:func:`core.planning.fleet.explain.explain`)."""
     served = {node for route in routes for node in route}
     return [
         explain(rules, node, left_out.get(node), routes)
@@ -467,7 +467,7 @@ def search(
     each solve its share of ``effort``'s work; ``minimize_vehicles``: fewer vans first, then
     the objective. With ``charging`` and stops then left out for their battery (or fewer vans
     first), the fleet is planned again with charges between stops
-    (:mod:`core.planning.fleet_charging`)."""
+    (:mod:`core.planning.charging.fleet_charging`)."""
     times = LearnedTimes(day.duration_s, day.finite, day.horizon_s)
     calibrate(day, times)
     # a limit too short for the verification's reserve still leaves the search half of it
@@ -586,9 +586,10 @@ def _charged(
     reserve_s: float,
     ends: list[SearchEnd],
 ) -> tuple[list[list[int]], dict[int, PlanResult], list[Unassigned]]:
-    """The fleet planned again with charges between stops (:mod:`core.planning.fleet_charging`),
-    kept when it does better than the routes ``found`` without; then the stops still left out
-    inserted one at a time with the charges they need (:mod:`core.planning.charge_insertion`)."""
+    """The fleet planned again with charges between stops
+    (:mod:`core.planning.charging.fleet_charging`), kept when it does better than the routes
+    ``found`` without; then the stops still left out inserted one at a time with the charges
+    they need (:mod:`core.planning.charging.charge_insertion`)."""
     routes, results, unassigned = found
     charged = charging_routes(
         day,

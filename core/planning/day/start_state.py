@@ -2,7 +2,7 @@
 position, at its time, with its charge, box temperature and payload, serves the stops left and
 returns to the depot.
 
-The van's position is one more place after the stops (:func:`core.planning.scene.round_places`);
+The van's position is one more place after the stops (:func:`core.planning.day.scene.round_places`);
 the order is the shortest path from it through every stop to the depot (:func:`path_tour`).
 """
 

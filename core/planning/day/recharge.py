@@ -3,7 +3,7 @@ stops at a charger — the depot's or one on the way — as often as it needs, a
 the rest needs (partial recharge).
 
 The charges split the round into stretches. Each pass simulates the day in full
-(:func:`core.planning.verify.simulate_route`) and
+(:func:`core.planning.day.verify.simulate_route`) and
 
 1. for the first stretch that runs below the reserve, weighs every stop the van leaves with
    its reserve and every charger it reaches from there with its reserve (the simulated day's
@@ -38,10 +38,10 @@ from typing import Protocol
 from core.params import ChargePoint, Charger, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, ChargeCurve, charge_curve
+from core.planning.day.scene import Scene, charge_points
+from core.planning.day.timeline import ChargeVisit, Windows, next_window, seconds_after
+from core.planning.day.verify import simulate_route
 from core.planning.model import PlanProblem, PlanResult, Solved
-from core.planning.scene import Scene, charge_points
-from core.planning.timeline import ChargeVisit, Windows, next_window, seconds_after
-from core.planning.verify import simulate_route
 from core.routing.roads import LegRoute
 
 #: State of charge charged beyond what the next stretch needs and its reserve [–]: the

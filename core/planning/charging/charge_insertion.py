@@ -1,11 +1,11 @@
 """The stops still left out for their battery after the charging search
-(:mod:`core.planning.fleet_charging`), tried one at a time in the verified routes — the one
+(:mod:`core.planning.charging.fleet_charging`), tried one at a time in the verified routes — the one
 place where a van that reloads gets its charges, as the charging search plans single trips.
 
 Each stop
 left out for its battery is then tried in the vans' routes at its cheapest places by distance
 on the objective (:data:`POSITIONS_TRIED` per van) and in a van not driving yet: the route
-simulated with the charges it needs (:func:`core.planning.recharge.with_charges`, from the
+simulated with the charges it needs (:func:`core.planning.day.recharge.with_charges`, from the
 charges it had: every later window and the shift's end kept, the charge points free only
 between the other vans' charges). The first that holds — fewer charges by the estimates
 first, then what the objective gains, a van already driving before a new one when the fleet
@@ -20,13 +20,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from core.planning.day import FleetDay
-from core.planning.fleet_charging import Bookings
+from core.planning.charging.fleet_charging import Bookings
+from core.planning.day.recharge import visits_of
+from core.planning.day.scene import charge_points
+from core.planning.day.timeline import ChargeVisit
+from core.planning.day.verify import route_failure
 from core.planning.model import PlanResult, Unassigned
-from core.planning.recharge import visits_of
-from core.planning.scene import charge_points
-from core.planning.timeline import ChargeVisit
-from core.planning.verify import route_failure
+from core.planning.search.day import FleetDay
 from core.routing.effort import Effort, SearchEnd
 from core.routing.vrp import trips_tidied
 

@@ -39,8 +39,8 @@ from core.physics.cycles import (
 )
 from core.physics.motor import power_limited
 from core.physics.simulate import MAX_SPEED_MPS
+from core.planning.day.start_state import start_payload_kg
 from core.planning.model import PlanProblem
-from core.planning.start_state import start_payload_kg
 from core.routing.geo import STREET_TYPE_NAMES, Legs, street_type_by_speed
 from core.routing.roads import LegRoute, bearing_deg
 

@@ -3,8 +3,8 @@
 1. legs between every ordered pair (:mod:`core.routing.geo`: the client's matrix, a road
    router's table or the estimate); 2. the order of the stops on the chosen objective: the
    round trip (:mod:`core.routing.tsp`), or, when stops have time windows, the fleet search of
-   :mod:`core.planning.fleet` with this one van; 3. the day driven and simulated in full
-   (:mod:`core.planning.verify`), with the weather for the round's span (a forecast service,
+   :mod:`core.planning.fleet.planner` with this one van; 3. the day driven and simulated in full
+   (:mod:`core.planning.day.verify`), with the weather for the round's span (a forecast service,
    the request, or the climatology).
 """
 
@@ -25,9 +25,19 @@ from core.exceptions import (
 )
 from core.params import Place
 from core.physics.weather import WeatherService
-from core.planning.day import VanShift, fleet_day, leg_roads
-from core.planning.estimates import cost_matrix
-from core.planning.fleet import search
+from core.planning.day.estimates import cost_matrix
+from core.planning.day.recharge import visits_of, with_charges
+from core.planning.day.scene import (
+    Scene,
+    charge_points,
+    legs_for,
+    round_field,
+    round_places,
+    weather_service_for,
+)
+from core.planning.day.start_state import START_ID, check_start, path_tour, under_way
+from core.planning.day.timeline import client_legs_too_fast, windows_after
+from core.planning.fleet.planner import search
 from core.planning.model import (
     MAX_ROUND_S,
     PlanProblem,
@@ -36,18 +46,8 @@ from core.planning.model import (
     check_places,
     cut_short,
 )
-from core.planning.recharge import visits_of, with_charges
-from core.planning.reloads import check_payload, with_reloads
-from core.planning.scene import (
-    Scene,
-    charge_points,
-    legs_for,
-    round_field,
-    round_places,
-    weather_service_for,
-)
-from core.planning.start_state import START_ID, check_start, path_tour, under_way
-from core.planning.timeline import client_legs_too_fast, windows_after
+from core.planning.round.reloads import check_payload, with_reloads
+from core.planning.search.day import VanShift, fleet_day, leg_roads
 from core.routing.effort import Effort, SearchEnd, combined
 from core.routing.geo import Legs
 from core.routing.roads import LegRoute, RememberingRouter, RoadRouter
@@ -233,7 +233,7 @@ def _in_windows(
     battery reported, not a constraint, and every stop required; a stop no order serves in
     time is an error naming it. When the battery does not last and there are chargers, the
     van charges where the time it adds keeps every later window
-    (:func:`core.planning.recharge.with_charges`)."""
+    (:func:`core.planning.day.recharge.with_charges`)."""
     remembering = None if router is None else RememberingRouter(router)
     van = VanShift("van", problem, start, None, battery_enforced=False)
     under_way = [len(problem.stops) + 1] if problem.start_state is not None else None

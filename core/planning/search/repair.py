@@ -9,10 +9,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.planning.estimates import VanEstimates
-from core.planning.feasibility import Feasibility
+from core.planning.day.estimates import VanEstimates
+from core.planning.day.verify import Failure
 from core.planning.model import PlanResult
-from core.planning.verify import Failure
+from core.planning.search.feasibility import Feasibility
 from core.routing.vrp import trips_tidied
 
 

@@ -1,6 +1,7 @@
-"""A route verified by the full simulation of its day: the timeline (:mod:`core.planning.timeline`)
-simulated in one vectorised pass (:func:`core.physics.simulate.simulate`), split per leg and per
-stop into a :class:`core.planning.model.PlanResult`, and the rules it breaks, if any
+"""A route verified by the full simulation of its day: the timeline
+(:mod:`core.planning.day.timeline`) simulated in one vectorised pass
+(:func:`core.physics.simulate.simulate`), split per leg and per stop into a
+:class:`core.planning.model.PlanResult`, and the rules it breaks, if any
 (:func:`route_failure`): a window missed, back after the shift, the charge below the reserve.
 """
 
@@ -18,6 +19,17 @@ from core.params import Location, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.cycles import trace_distance_m
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate
+from core.planning.day.scene import Scene, charge_points
+from core.planning.day.start_state import box_start_c, start_payload_kg
+from core.planning.day.timeline import (
+    PLAN_DT_S,
+    ChargeVisit,
+    Timeline,
+    Windows,
+    build_timeline,
+    later_departure_s,
+    rest_after,
+)
 from core.planning.model import (
     DEPOT_CHARGER_ID,
     BreakResult,
@@ -30,17 +42,6 @@ from core.planning.model import (
     Solved,
     StopResult,
     UnassignedReason,
-)
-from core.planning.scene import Scene, charge_points
-from core.planning.start_state import box_start_c, start_payload_kg
-from core.planning.timeline import (
-    PLAN_DT_S,
-    ChargeVisit,
-    Timeline,
-    Windows,
-    build_timeline,
-    later_departure_s,
-    rest_after,
 )
 from core.routing.roads import LegRoute
 

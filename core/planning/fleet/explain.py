@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from collections import Counter
 
-from core.planning.feasibility import Feasibility
+from core.planning.day.verify import Failure
 from core.planning.model import Unassigned, UnassignedReason
-from core.planning.verify import Failure
+from core.planning.search.feasibility import Feasibility
 
 #: Which reason names a stop that vans refuse for different reasons, when as many refuse it for
 #: each.
@@ -50,7 +50,7 @@ def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[Unass
     """A stop some van could serve on a round of its own, left out because the fleet is full:
     the rule that stops it from joining any van's route at its best place, the one most vans
     share. A van with no route that would serve it alone has been given it (or its
-    simulation said why not, :func:`core.planning.fleet.search`): the vans without a route
+    simulation said why not, :func:`core.planning.fleet.planner.search`): the vans without a route
     refuse it alone, and their reason comes first."""
     idle = [why for v, route in enumerate(routes) if not route and (why := rules.alone(v, node))]
     if idle:

@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
-from core.planning.feasibility import Feasibility
-from core.planning.start_state import start_payload_kg
+from core.planning.day.start_state import start_payload_kg
+from core.planning.search.feasibility import Feasibility
 from core.routing.units import energy_units_down, energy_units_up, payload_units_down
 from core.routing.vrp import RoutingInput, VehicleSpec
 

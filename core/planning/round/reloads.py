@@ -5,9 +5,9 @@ Without time windows the round trip's order stays: walking it from the depot (or
 position when it is under way, with what it carries), the van comes back to reload before the
 first stop whose delivery it no longer carries (the payload back to ``payload_kg``), as often
 as it must; each trip is then put in its own best order. With time windows the fleet search
-with this one van places the reloads (:mod:`core.planning.round`). More trips than
+with this one van places the reloads (:mod:`core.planning.round.planner`). More trips than
 ``max_trips`` is an error naming the stops. The timeline stands the van at the depot, parked, for
-``reload_minutes`` (:meth:`core.planning.timeline._Builder.reload`).
+``reload_minutes`` (:meth:`core.planning.day.timeline._Builder.reload`).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from core.exceptions import InvalidStopsError
+from core.planning.day.start_state import start_payload_kg
 from core.planning.model import PlanProblem
-from core.planning.start_state import start_payload_kg
 from core.routing.units import payload_units_down, payload_units_up
 
 #: A trip's places (the depot first and last) in a better order, the depot still first and last.
