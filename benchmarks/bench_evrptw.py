@@ -298,10 +298,11 @@ def evrptw_tables(budget_s: float = BUDGET_S) -> None:
 
 
 def vienna_day(chargers: bool, battery_kwh: float, budget_s: float) -> dict[str, Any]:
-    """The issue's Vienna day: 80 stops within 30 km, 30 °C, ten ``ev-van-3.5t-reefer`` with
-    ``battery_kwh``; with ``chargers`` a 22 kW depot charger and two 150 kW ones."""
+    """The issue's Vienna day: 80 stops within 30 km (a box of ±21 km), 30 °C, ten
+    ``ev-van-3.5t-reefer`` with ``battery_kwh`` on the default shift (08:00–18:00, EU breaks);
+    with ``chargers`` a 22 kW depot charger and two 150 kW ones 10 km north and south."""
     rng = np.random.default_rng(29)
-    stops = vienna_stops(rng, 80, 300.0, 90.0, 10.0, spread_deg=(0.2, 0.3))
+    stops = vienna_stops(rng, 80, 300.0, 90.0, 10.0, spread_deg=(0.19, 0.28))
     depot: dict[str, Any] = {"id": "depot", "lat": 48.21, "lon": 16.37}
     body: dict[str, Any] = {
         "date": "2026-07-15",
@@ -312,8 +313,6 @@ def vienna_day(chargers: bool, battery_kwh: float, budget_s: float) -> dict[str,
                 "id": f"van-{k + 1}",
                 "vehicle": {"preset": "ev-van-3.5t-reefer"},
                 "battery": {"usable_capacity_kwh": battery_kwh, "min_soc": 0.1},
-                "shift_start": "06:00",
-                "shift_end": "18:00",
             }
             for k in range(10)
         ],

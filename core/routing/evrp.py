@@ -166,12 +166,19 @@ def solve_evrptw(
     instance: EvrpInstance, effort: Effort, initial: Routes | None = None
 ) -> EvrpSolution:
     """Every customer served if the fleet can, then fewest vehicles (``fewest_vehicles``),
-    then the least cost, from ``initial`` routes (kind, customers) or PyVRP's (step 1, when
-    every vehicle sets off from the depot), in ``effort``'s work."""
-    search = _Search(instance, np.random.default_rng(effort.seed))
-    if initial is None:
-        initial = _customer_routes(instance, effort.share(ROUTING_SHARE))
-    search.start(initial)
+    then the least cost, in ``effort``'s work: from the better start of ``initial`` routes
+    (kind, customers) and PyVRP's (step 1, when every vehicle sets off from the depot: it sees
+    part of the charging time, routes found without may not)."""
+    starts = [] if initial is None else [initial]
+    if all(kind.start == 0 for kind in instance.kinds):
+        starts.append(_customer_routes(instance, effort.share(ROUTING_SHARE)))
+    if not starts:
+        raise ValueError("routes of customers for vehicles under way must be given")
+    searches = []
+    for routes in starts:
+        searches.append(_Search(instance, np.random.default_rng(effort.seed)))
+        searches[-1].start(routes)
+    search = min(searches, key=lambda s: s.total())
     ended = search.improve(effort.work_s * (1.0 - ROUTING_SHARE), effort)
     return search.solution(ended)
 
@@ -179,8 +186,6 @@ def solve_evrptw(
 def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
     """Step 1: PyVRP's routes of the customers, charging time partly in the arcs (the first
     kind's energy), every kind a vehicle type of its own."""
-    if any(kind.start != 0 for kind in instance.kinds):
-        raise ValueError("routes of customers for vehicles under way must be given")
     customers = instance.customers
     nodes = [0, *customers]
     arcs = np.ix_(nodes, nodes)

@@ -12,8 +12,8 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    and full, what it holds at departure, its payload, its shift and where it sets off; each
    charger's charge time per joule (the van's charging curve at the charger's power, reserve
    to 80 %) and its plug-in time; each stop's window (the first opening to the last close).
-2. **The search** starts from its own routes of the stops, found with part of the charging
-   time in the arcs (when every van leaves the depot), or else from the routes the fleet's
+2. **The search** starts from the better of its own routes of the stops, found with part of
+   the charging time in the arcs (when every van leaves the depot), and the routes the fleet's
    search found without charging (the stops left out inserted where they cost least), and
    serves every stop it can, then fewest vans (when asked), then the objective.
 3. **Verification**: each route is simulated with its charges fitted to what the simulation
@@ -267,9 +267,9 @@ def charging_routes(
     minimize_vehicles: bool,
     effort: Effort,
 ) -> Charging:
-    """The fleet's routes with charging (module docstring): from the search's own start when
-    every van leaves the depot, else from ``routes`` (stops per van, a 0 a return to reload)
-    found without. A route whose simulation runs below its reserve
+    """The fleet's routes with charging (module docstring), from the better start of the
+    search's own (every van at the depot) and ``routes`` (stops per van, a 0 a return to
+    reload) found without. A route whose simulation runs below its reserve
     makes its kind of van's battery (and its charge at departure) smaller in the search by what
     the simulation fell below the reserve, :data:`TIGHTEN_MARGIN` times, and the search starts
     again from ``routes`` (which hold without charging; the routes it found may not hold with
@@ -277,11 +277,7 @@ def charging_routes(
     :data:`CHARGING_ROUNDS` times; the best verified routes are kept."""
     charging = charging_instance(day, times_s, minimize_vehicles)
     kind_of = {v: k for k, vans in enumerate(charging.vans_of) for v in vans}
-    initial: list[tuple[int, list[int]]] | None = [
-        (kind_of[v], [p for p in route if p]) for v, route in enumerate(routes) if route
-    ]
-    if all(kind.start == 0 for kind in charging.instance.kinds):
-        initial = None  # the search's own start sees the charging time (rc201: −5 % distance)
+    initial = [(kind_of[v], [p for p in route if p]) for v, route in enumerate(routes) if route]
     best: Charging | None = None
     ends: list[SearchEnd] = []
     for round_ in range(CHARGING_ROUNDS):

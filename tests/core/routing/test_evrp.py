@@ -201,6 +201,17 @@ def test_a_small_instance_is_solved_as_well_as_every_split_and_order_allows():
     assert check(inst, routes) is None
 
 
+def test_the_search_starts_from_the_better_of_the_given_routes_and_its_own():
+    """Routes found without charging may be poor with it: one customer per vehicle is worse
+    than PyVRP's start, so the search starts from PyVRP's and ends where it ends alone."""
+    inst = small()
+    alone = [(0, [c]) for c in inst.customers]
+    effort = Effort(1e-4, math.inf, seed=1)  # no work left after the start
+    from_poor = solve_evrptw(inst, effort, alone)
+    assert from_poor == solve_evrptw(inst, effort)
+    assert from_poor.vehicles < len(alone)
+
+
 def test_the_independent_check_names_what_a_route_breaks():
     inst = on_a_line()
     assert check(inst, [[(0, 0.0), (1, 0.0), (0, 0.0)]]) == "route 0 runs empty before place 0"
