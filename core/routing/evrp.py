@@ -30,6 +30,7 @@ and when, by when it is back, its battery and the energy of each arc for it.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -88,7 +89,10 @@ ELIMINATION_EVERY = 10
 class VehicleKind:
     """Vehicles alike: how many, the energy each arc takes them, their battery (the most it
     holds above its floor, and what it holds at departure), their load capacity, the place
-    they set off from, their earliest departure and latest return to the depot."""
+    they set off from, their earliest departure and latest return to the depot; what their
+    first trip may deliver (less when they set off loaded in part), and for vehicles that come
+    back to reload, the place that return is (the depot's row, its service the reload's time)
+    and their most trips."""
 
     count: int
     energy: FloatArray
@@ -98,6 +102,36 @@ class VehicleKind:
     start: int = 0
     ready: float = 0.0
     due: float = math.inf
+    aboard: float = math.inf
+    reload: int = -1
+    max_trips: int = 1
+
+    def trips_carried(self, demand: FloatArray, route: Sequence[int]) -> bool:
+        """Whether ``route`` (customers, :attr:`reload` between trips) keeps to the trips and
+        each trip's load."""
+        limit, load, trips = min(self.aboard, self.capacity), 0.0, 1
+        for place in route:
+            if place == self.reload:
+                limit, load, trips = self.capacity, 0.0, trips + 1
+            else:
+                load += float(demand[place])
+                if load > limit + 1e-9:
+                    return False
+        return trips <= self.max_trips
+
+    def tidied(self, route: list[int]) -> list[int]:
+        """``route`` without returns to reload that end it, follow another or begin it (a
+        vehicle under way may come back to reload first)."""
+        if self.reload < 0 or self.reload not in route:
+            return route
+        out: list[int] = []
+        for place in route:
+            if place == self.reload and (out[-1:] == [self.reload] or (not out and not self.start)):
+                continue
+            out.append(place)
+        while out and out[-1] == self.reload:
+            out.pop()
+        return out
 
 
 @dataclass(frozen=True)
@@ -263,11 +297,12 @@ class _Priced:
 
     def _evaluated(self, kind: int, route: list[int]) -> Charged:
         vehicle = self.instance.kinds[kind]
+        route = vehicle.tidied(route)
         seq = np.array([vehicle.start, *route, 0], dtype=np.int64)
         self.evaluations += 1
         self.squares += seq.size**2
         load = float(self.instance.demand[seq].sum())
-        if load > vehicle.capacity + 1e-9:
+        if not vehicle.trips_carried(self.instance.demand, route):
             return NO_ROUTE
         cost, warp, gaps, charges = route_with_stations(
             self.facts[kind], seq, self.candidates, self.penalty
@@ -292,6 +327,7 @@ class _Search:
         self.routes: Routes = []
         self.left: list[int] = []
         self.priced = _Priced(instance)
+        self.is_customer = frozenset(instance.customers)
         self.charged = self.priced.charged
         self.cost = self.priced.cost
         self.moves = 0
@@ -316,6 +352,10 @@ class _Search:
         vehicles = len(self.routes) if self.instance.fewest_vehicles else 0
         return len(self.left), vehicles, sum(self.cost(k, r) for k, r in self.routes)
 
+    def _customers(self, route: list[int]) -> list[int]:
+        """The customers of ``route`` (not its returns to reload)."""
+        return [c for c in route if c in self.is_customer]
+
     def spare(self, kind: int) -> bool:
         """Whether a vehicle of ``kind`` is not driving yet."""
         used = sum(1 for k, _ in self.routes if k == kind)
@@ -330,18 +370,19 @@ class _Search:
             if not self.spare(kind):
                 left.extend(route)
                 continue
-            while route and math.isinf(self.cost(kind, route)):
+            while self._customers(route) and math.isinf(self.cost(kind, route)):
                 # the customer whose leaving makes the route hold at the least cost, else
                 # the one farthest out
-                shorter = [(self.cost(kind, [x for x in route if x != c]), c) for c in route]
+                within = self._customers(route)
+                shorter = [(self.cost(kind, [x for x in route if x != c]), c) for c in within]
                 fits = [sc for sc in shorter if math.isfinite(sc[0])]
                 if fits:
                     worst = min(fits)[1]
                 else:
-                    worst = max(route, key=lambda c: self.instance.distance[0, c])
+                    worst = max(within, key=lambda c: self.instance.distance[0, c])
                 route.remove(worst)
                 left.append(worst)
-            if route:
+            if self._customers(route):
                 self.routes.append((kind, route))
         served = {c for _, r in self.routes for c in r} | set(left)
         left += [c for c in self.instance.customers if c not in served]
@@ -358,11 +399,12 @@ class _Search:
         evaluations."""
         best: tuple[float, list[int]] | None = None
         at = -1
-        for bound, r, k in self._bounds(customer):
+        for bound, r, k, trip in self._bounds(customer):
             if best is not None and bound >= best[0] - 1e-9:
                 break
             kind, route = self.routes[r]
-            longer = [*route[:k], customer, *route[k:]]
+            added = [self.instance.kinds[kind].reload, customer] if trip else [customer]
+            longer = [*route[:k], *added, *route[k:]]
             extra = self.cost(kind, longer) - self.cost(kind, route)
             if best is None or extra < best[0]:
                 best, at = (extra, longer), r
@@ -371,34 +413,42 @@ class _Search:
             return True
         if not allow_new:
             return False
-        alone = [
-            (self.cost(kind, [customer]), kind)
-            for kind in range(len(self.instance.kinds))
+        alone = [  # a vehicle under way may come back to reload first
+            (self.cost(kind, route), kind, route)
+            for kind, vehicle in enumerate(self.instance.kinds)
             if self.spare(kind)
+            for route in ([customer], [vehicle.reload, customer])[: 1 + (vehicle.reload >= 0)]
         ]
         fits = [ck for ck in alone if math.isfinite(ck[0])]
         if not fits:
             return False
-        self.routes.append((min(fits)[1], [customer]))
+        _, kind, route = min(fits)
+        self.routes.append((kind, route))
         return True
 
-    def _bounds(self, customer: int) -> list[tuple[float, int, int]]:
+    def _bounds(self, customer: int) -> list[tuple[float, int, int, bool]]:
         """Each place in the routes ``customer`` may join (load, a neighbour there) with a
-        lower bound on what it adds, least first."""
+        lower bound on what it adds, least first; for a vehicle with trips to spare, also on
+        a trip of its own there (a return to reload before it: no shorter, the distances
+        being metric)."""
         inst = self.instance
         demand = inst.demand[customer]
         near = self.near[customer]
-        bounds: list[tuple[float, int, int]] = []
+        bounds: list[tuple[float, int, int, bool]] = []
         for r, (kind, route) in enumerate(self.routes):
-            if self.charged(kind, route).load + demand > inst.kinds[kind].capacity:
+            vehicle = inst.kinds[kind]
+            one_trip = vehicle.reload < 0  # else each trip's load: evaluated
+            if one_trip and self.charged(kind, route).load + demand > vehicle.capacity:
                 continue
             if not near.intersection(route):
                 continue  # no neighbour of it there: it would cost more than where they are
-            seq = np.array([inst.kinds[kind].start, *route, 0])
+            seq = np.array([vehicle.start, *route, 0])
             arcs = inst.distance[seq[:-1], seq[1:]]
             detour = inst.distance[seq[:-1], customer] + inst.distance[customer, seq[1:]] - arcs
             spare = self.cost(kind, route) - float(arcs.sum())  # stations and lateness
-            bounds.extend((float(d) - spare, r, k) for k, d in enumerate(detour))
+            bounds.extend((float(d) - spare, r, k, False) for k, d in enumerate(detour))
+            if not one_trip and route.count(vehicle.reload) < vehicle.max_trips - 1:
+                bounds.extend((float(d) - spare, r, k, True) for k, d in enumerate(detour))
         bounds.sort()
         return bounds
 
@@ -467,7 +517,7 @@ class _Search:
         order = sorted(range(len(self.routes)), key=lambda r: len(self.routes[r][1]))
         _, out = self.routes.pop(order[nth % len(order)])
         self.priced.penalty = LATE_PENALTY
-        if not all(self.insert(c, allow_new=False) for c in out):
+        if not all(self.insert(c, allow_new=False) for c in self._customers(out)):
             (self.routes, self.left), self.priced.penalty = saved, math.inf
             return False
         while self.late() > 1e-9 and self.spent_s < until and not effort.out_of_time():
@@ -489,14 +539,14 @@ class _Search:
         customers = self.instance.customers
         seed = int(self.rng.integers(len(customers)))
         if late_first:
-            late = [r for k, r in self.routes if self.charged(k, r).warp > 0]
+            late = [self._customers(r) for k, r in self.routes if self.charged(k, r).warp > 0]
             if late:
                 pick = late[int(self.rng.integers(len(late)))]
                 seed = customers.index(pick[int(self.rng.integers(len(pick)))])
         size = int(self.rng.integers(2, RUIN_SIZE + 1))
         taken = {customers[k] for k in self.nearest[seed][:size]} - set(self.left)
         self.routes = [(k, [c for c in r if c not in taken]) for k, r in self.routes]
-        self.routes = [(k, r) for k, r in self.routes if r]
+        self.routes = [(k, r) for k, r in self.routes if self._customers(r)]
         placed = all(
             self.insert(int(c), allow_new=not late_first)
             for c in self.rng.permutation(sorted(taken))

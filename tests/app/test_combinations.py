@@ -149,3 +149,34 @@ def test_a_fleet_with_windows_reloads_a_van_under_way_shifts_breaks_and_chargers
         assert back <= dt.time.fromisoformat(van["shift_end"])
     # 960 kg on 300 × 2 + 200 + 250 × 2 kg: both vans come back to reload
     assert all(route["reloads"] for route in routes.values())
+
+
+def test_a_fleet_that_must_charge_and_reload_serves_every_stop(client):
+    """The same fleet with 10 kWh batteries: neither van lasts the day without charging, and
+    both come back to reload — the charging search plans the trips, the charges and the
+    returns together (a return to reload beside a charge at the depot is one stop)."""
+    first, second = FLEET_PLAN_EXAMPLE["vehicles"]
+    vans = [
+        first
+        | {"max_trips": 2, "payload_kg": 300, "breaks": "eu-561"}
+        | {"battery": {"usable_capacity_kwh": 10}},
+        second
+        | {"max_trips": 3, "payload_kg": 250, "start_state": UNDER_WAY}
+        | {"battery": {"usable_capacity_kwh": 10, "min_soc": 0.15}},
+    ]
+    body = FLEET_PLAN_EXAMPLE | {
+        "stops": STOPS,
+        "depot": DEPOT,
+        "chargers": CHARGERS,
+        "vehicles": vans,
+        "time_limit_s": 3,
+    }
+    response = client.post("/v1/fleet-plans", json=body)
+    assert response.status_code == 200, response.text[:400]
+    answer = response.json()
+    assert answer["unassigned"] == []
+    assert sum(len(route["charges"]) for route in answer["routes"]) >= 1
+    for route in answer["routes"]:
+        van = next(v for v in vans if v["id"] == route["vehicle_id"])
+        aboard = van.get("start_state", {}).get("payload_kg", van["payload_kg"])
+        check_rules(route, STOPS, van["payload_kg"], aboard)

@@ -1,2 +1,2 @@
-"""Charging in a fleet's day: the E-VRPTW search in the product (:mod:`.fleet_charging`), and
-the stops still left out inserted with the charges they need (:mod:`.charge_insertion`)."""
+"""Charging in a fleet's day: the E-VRPTW search in the product, its routes verified by the
+full simulation with their charges fitted and the charge points booked (:mod:`.fleet_charging`)."""

@@ -41,6 +41,7 @@ from core.physics.charging import WATTS_PER_KW, charge_curve
 from core.planning.day.estimates import cost_matrix, energy_matrix_j
 from core.planning.day.recharge import Busy
 from core.planning.day.scene import charge_points
+from core.planning.day.start_state import start_payload_kg
 from core.planning.day.timeline import ChargeVisit
 from core.planning.day.verify import Failure, route_failure
 from core.planning.model import DEPOT_CHARGER_ID, PlanResult
@@ -120,13 +121,15 @@ def _full(
 @dataclass(frozen=True)
 class ChargingInstance:
     """The search's instance of a fleet's day, and how to read its answer: the product's
-    place of each of the search's places (the depot's charger is the depot), the vans of each
-    kind, and each charger's plug-in time [s] and power [kW]."""
+    place of each of the search's places (the depot's charger and the returns to reload are
+    the depot), the vans of each kind, each charger's plug-in time [s] and power [kW], and the
+    search's places that are returns to reload."""
 
     instance: EvrpInstance
     place_of: list[int]
     vans_of: list[list[int]]
     points: dict[int, ChargePoint]
+    reloads: frozenset[int] = frozenset()
 
 
 def charging_instance(
@@ -140,6 +143,11 @@ def charging_instance(
     every = day.scene.legs
     legs = long_where_no_road(every, np.isfinite(every.duration_s) & np.isfinite(every.distance_m))
     place_of = list(range(len(places))) + ([0] if 0 in points else [])
+    stations = [q for q, p in enumerate(place_of) if p in points and (q > 0)]
+    reload_place = {}  # a return to reload: a place of the depot's, one per reload time
+    for reload_s in sorted({_reload_s(day, v) for v in day.vans if _reloads(day, v)}):
+        reload_place[reload_s] = len(place_of)
+        place_of.append(0)
     at = np.array(place_of)
     arcs = np.ix_(at, at)
     n = day.n
@@ -149,9 +157,10 @@ def charging_instance(
     duration *= ratio if taught.any() else 1.0
     duration[:n, :n] = np.where(day.finite, times_s, duration[:n, :n])
     arc_cost, unit_value, _ = cost_matrix(problem, legs, day.shifts[0].start)
-    stations = [q for q, p in enumerate(place_of) if p in points and (q > 0)]
     ready, due, service = _windows(day, len(place_of), stations, place_of, points)
-    kinds, vans_of = _kinds(day, legs, arcs)
+    for reload_s, q in reload_place.items():
+        service[q] = reload_s
+    kinds, vans_of = _kinds(day, legs, arcs, reload_place)
     charge_time = np.zeros(len(place_of))
     for q in stations:
         charge_time[q] = _seconds_per_joule(day, points[place_of[q]])
@@ -168,7 +177,7 @@ def charging_instance(
         kinds=kinds,
         fewest_vehicles=minimize_vehicles,
     )
-    return ChargingInstance(instance, place_of, vans_of, points)
+    return ChargingInstance(instance, place_of, vans_of, points, frozenset(reload_place.values()))
 
 
 def _windows(
@@ -190,13 +199,26 @@ def _windows(
     return ready, due, service
 
 
+def _reloads(day: FleetDay, v: int) -> bool:
+    return day.shifts[v].problem.max_trips > 1
+
+
+def _reload_s(day: FleetDay, v: int) -> float:
+    return day.shifts[v].problem.reload_minutes * 60.0
+
+
 def _kinds(
-    day: FleetDay, legs: Legs, arcs: tuple[np.ndarray, ...]
+    day: FleetDay, legs: Legs, arcs: tuple[np.ndarray, ...], reload_place: dict[float, int]
 ) -> tuple[list[VehicleKind], list[list[int]]]:
-    """The fleet's kinds — vans alike in estimates, shift and start — and their vans."""
-    groups: dict[tuple[int, tuple[float, float], int], list[int]] = {}
+    """The fleet's kinds — vans alike in estimates, shift, start, what they carry at first
+    and their trips — and their vans; a return to reload draws the van's standing loads for
+    the reload's time."""
+    groups: dict[tuple[object, ...], list[int]] = {}
     for v in day.vans:
-        groups.setdefault((id(day.estimates[v]), day.shift_s[v], day.starts[v]), []).append(v)
+        problem = day.shifts[v].problem
+        trips = (problem.max_trips, problem.reload_minutes, start_payload_kg(problem))
+        key = (id(day.estimates[v]), day.shift_s[v], day.starts[v], trips)
+        groups.setdefault(key, []).append(v)
     kinds = []
     for vans in groups.values():
         v = vans[0]
@@ -205,18 +227,25 @@ def _kinds(
         estimates = day.estimates[v]
         energy = energy_matrix_j(problem, legs, shift.start)
         energy[: day.n, : day.n] = estimates.energy_j
+        energy = energy[arcs]
+        reload = reload_place[_reload_s(day, v)] if _reloads(day, v) else -1
+        if reload >= 0:
+            energy[reload] += estimates.standing_w * _reload_s(day, v)
         battery = problem.van.battery
         window = battery.initial_soc - battery.min_soc
         kinds.append(
             VehicleKind(
                 count=len(vans),
-                energy=energy[arcs],
+                energy=energy,
                 battery=estimates.budget_j * (1.0 - battery.min_soc) / window * BATTERY_MARGIN,
                 initial=estimates.budget_j * BATTERY_MARGIN if shift.battery_enforced else math.inf,
                 capacity=float(payload_units_down(problem.van.payload_kg)),
                 start=day.starts[v],
                 ready=day.shift_s[v][0],
                 due=day.shift_s[v][1],
+                aboard=float(payload_units_down(start_payload_kg(problem))),
+                reload=reload,
+                max_trips=problem.max_trips,
             )
         )
     return kinds, list(groups.values())
@@ -277,7 +306,12 @@ def charging_routes(
     :data:`CHARGING_ROUNDS` times; the best verified routes are kept."""
     charging = charging_instance(day, times_s, minimize_vehicles)
     kind_of = {v: k for k, vans in enumerate(charging.vans_of) for v in vans}
-    initial = [(kind_of[v], [p for p in route if p]) for v, route in enumerate(routes) if route]
+    kinds = charging.instance.kinds
+    initial = [
+        (kind_of[v], _with_reloads(route, kinds[kind_of[v]].reload))
+        for v, route in enumerate(routes)
+        if route
+    ]
     best: Charging | None = None
     ends: list[SearchEnd] = []
     for round_ in range(CHARGING_ROUNDS):
@@ -295,6 +329,12 @@ def charging_routes(
         charging = replace(charging, instance=_tightened(charging.instance, short))
     assert best is not None
     return replace(best, ended=combined(ends))
+
+
+def _with_reloads(route: list[int], reload: int) -> list[int]:
+    """The stops of ``route`` for the search: a return to reload (a 0) as the kind's place
+    for it, or none when the kind does not reload."""
+    return [place or reload for place in route if place or reload >= 0]
 
 
 def _ranked(day: FleetDay, charging: Charging, fewest_vans: bool) -> tuple[int, int, float]:
@@ -339,6 +379,8 @@ def _verified(
             for q, visit in enumerate(route.visits)
             if 0 < q < len(order) - 1 and visit.place in charging.instance.stations
         }
+        reloads = [q for q, visit in enumerate(route.visits) if visit.place in charging.reloads]
+        order, charges = _charged_while_reloading(order, charges, reloads)
         repaired, first = _held(day, v, order, charges, bookings)
         if first is not None and first.battery.margin_kwh < 0:
             below_j = -first.battery.margin_kwh * JOULES_PER_KWH
@@ -349,6 +391,23 @@ def _verified(
             results[v] = repaired.result
             bookings.book(day.shifts[v].id, index, repaired.result)
     return Charging(routes, results, removed, solution.ended), short
+
+
+def _charged_while_reloading(
+    order: list[int], charges: dict[int, ChargeVisit], reloads: list[int]
+) -> tuple[list[int], dict[int, ChargeVisit]]:
+    """``order`` with a return to reload (at positions ``reloads``) beside a charge at the
+    depot made one stop: the charge, the van reloaded meanwhile (the search sees them one
+    after the other)."""
+    dropped = set()
+    for q in reloads:
+        beside = next((p for p in (q - 1, q + 1) if p in charges and order[p] == 0), None)
+        if beside is not None:
+            charges[beside] = replace(charges[beside], reloads=True)
+            dropped.add(q)
+    kept = [q for q in range(len(order)) if q not in dropped]
+    renumbered = {n: charges[q] for n, q in enumerate(kept) if q in charges}
+    return [order[q] for q in kept], renumbered
 
 
 def _visit(point: ChargePoint, charge_j: float, instance: EvrpInstance, q: int) -> ChargeVisit:
@@ -370,7 +429,11 @@ def _held(
     holds (the chargers stay where they are); and its first simulation when neither held."""
     shift = day.shifts[v]
     busy = bookings.busy(shift.id)
-    stops = [place for q, place in enumerate(order) if 0 < q < len(order) - 1 and q not in charges]
+    stops = [  # a charge at the depot while the van reloads is its return to reload too
+        place
+        for q, place in enumerate(order)
+        if 0 < q < len(order) - 1 and (q not in charges or charges[q].reloads)
+    ]
 
     def simulate(kept: list[int]) -> PlanResult:
         keep = set(kept)

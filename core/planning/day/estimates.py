@@ -125,6 +125,8 @@ class VanEstimates:
         time, and energy, for the van stands with its loads on.
     start
         The place the van sets off from: the depot (0), or its position when under way.
+    standing_w
+        What the van draws standing with its loads on (auxiliaries, cab, box) [W].
     """
 
     arc_cost: NDArray[np.int64]
@@ -134,6 +136,7 @@ class VanEstimates:
     budget_j: float
     wait_cost_per_s: int
     start: int = 0
+    standing_w: float = 0.0
 
     def route_cost(self, route: Sequence[int]) -> float:
         """The objective's value of a route of stops (from the start, back to the depot), in
@@ -193,6 +196,7 @@ def van_estimates(
         energy_j=energy_matrix_j(problem, legs, start) + stop_j[:, None],
         budget_j=budget_j,
         wait_cost_per_s=wait_cost,
+        standing_w=parked_w,
     )
 
 

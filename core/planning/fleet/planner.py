@@ -42,7 +42,6 @@ from core.exceptions import CoreError, InvalidParameterError, NoRouteError
 from core.params import Place
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import WeatherService, forecast_for
-from core.planning.charging.charge_insertion import serve_with_charging
 from core.planning.charging.fleet_charging import charging_routes, measure
 from core.planning.day.estimates import LearnedTimes
 from core.planning.day.scene import Scene, legs_for, round_field
@@ -586,10 +585,9 @@ def _charged(
     reserve_s: float,
     ends: list[SearchEnd],
 ) -> tuple[list[list[int]], dict[int, PlanResult], list[Unassigned]]:
-    """The fleet planned again with charges between stops
+    """The fleet planned again with charges between stops and returns to reload
     (:mod:`core.planning.charging.fleet_charging`), kept when it does better than the routes
-    ``found`` without; then the stops still left out inserted one at a time with the charges
-    they need (:mod:`core.planning.charging.charge_insertion`)."""
+    ``found`` without; a stop still left out for its battery says that charging was tried."""
     routes, results, unassigned = found
     charged = charging_routes(
         day,
@@ -604,8 +602,13 @@ def _charged(
     ):
         routes, results = charged.routes, charged.results
         unassigned = _unassigned(rules, routes, charged.removed)
-    routes, results, unassigned, inserted = serve_with_charging(
-        day, routes, results, unassigned, minimize_vehicles, effort
+    said = "charging did not let a van serve it either (no charger within reach, or no time for "
+    said += "the charge)"
+    return (
+        routes,
+        results,
+        [
+            replace(u, detail=f"{u.detail}; {said}") if u.reason == "battery" else u
+            for u in unassigned
+        ],
     )
-    ends.append(inserted)
-    return routes, results, unassigned

@@ -62,6 +62,18 @@ def test_the_stops_a_battery_left_out_are_served_with_a_charger(one_van):
             assert "charging did not let a van serve it" in u.detail
 
 
+
+def test_a_stop_charging_cannot_save_says_charging_was_tried():
+    """A charger 140 km away: the stops the battery leaves out stay out, and each says that
+    charging was tried (a dispatcher would otherwise add chargers in vain)."""
+    day = summer_day(None)
+    far = Charger(id="far-away", lat=49.47, lon=16.40, power_kw=150, price_per_kwh=0.59)
+    result = plan_fleet(fleet(day, [day.van], chargers=[far], time_limit_s=10))
+    left = [u for u in result.unassigned if u.reason == "battery"]
+    assert len(left) >= 10
+    assert all("charging did not let a van serve it" in u.detail for u in left)
+    assert not any(r.plan.charges for r in result.routes)
+
 def two_clusters() -> FleetProblem:
     """Two vans of 10 kWh until 14:00, 12 stops 10 km out east and 12 west (8 min each):
     one van cannot serve them all in its shift, and each needs charges at the depot's

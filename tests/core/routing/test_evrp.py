@@ -212,6 +212,31 @@ def test_the_search_starts_from_the_better_of_the_given_routes_and_its_own():
     assert from_poor.vehicles < len(alone)
 
 
+def test_a_vehicle_that_may_reload_serves_more_than_one_load():
+    """One vehicle of 3 for the five customers of the small instance without windows: with
+    a return to reload (a place of the depot's, 5 to reload) and two trips it serves them all,
+    no trip over 3; without, one load of three."""
+    reload = len(SMALL_XY)
+    inst = instance(
+        [*SMALL_XY, SMALL_XY[0]],
+        "dcccccfffr",
+        service=np.array([0.0, 10, 10, 10, 10, 10, 0, 0, 0, 5]),
+        capacity=3.0,
+        battery=70.0,
+        time_per_energy=1.0,
+    )
+    one = replace(inst.kinds[0], count=1)
+    alone = solve_evrptw(replace(inst, kinds=[one]), Effort(0.3, math.inf, seed=1))
+    assert len(alone.left_out) == 2
+    trips = replace(one, reload=reload, max_trips=2)
+    solution = solve_evrptw(replace(inst, kinds=[trips]), Effort(0.3, math.inf, seed=1))
+    assert solution.left_out == [] and solution.vehicles == 1
+    places = [visit.place for visit in solution.routes[0].visits]
+    assert places.count(reload) == 1
+    cut = places.index(reload)
+    assert max(sum(inst.demand[places[:cut]]), sum(inst.demand[places[cut:]])) <= 3.0
+
+
 def test_the_independent_check_names_what_a_route_breaks():
     inst = on_a_line()
     assert check(inst, [[(0, 0.0), (1, 0.0), (0, 0.0)]]) == "route 0 runs empty before place 0"
