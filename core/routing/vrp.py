@@ -272,8 +272,6 @@ def _pyvrp_model(problem: RoutingInput, required: bool) -> _PyvrpModel:
     clients, one per window, of which the route visits one. Every stop ``required``, or
     optional for a prize (:func:`_prize`)."""
     n = problem.travel_s.shape[0]
-    horizon = int(problem.horizon_s)
-    never = horizon + 1
     large_fixed = max((v.fixed_cost for v in problem.vehicles), default=0) > len(problem.vehicles)
     scale = _cost_scale(problem, large_fixed)
 
@@ -284,33 +282,7 @@ def _pyvrp_model(problem: RoutingInput, required: bool) -> _PyvrpModel:
     prize = _prize(problem, scale, large_fixed)
 
     locations = [pyvrp.Location(0.0, 0.0) for _ in range(n)]
-    clients: list[pyvrp.Client] = []
-    client_node: list[int] = []
-    node_clients: dict[int, list[int]] = {}
-    groups: list[pyvrp.ClientGroup] = []
-    for node in range(1, n):
-        windows = problem.windows_s[node] or [(0, horizon)]
-        if windows[0][0] >= never:  # no van can ever serve it (or a van sets off there)
-            continue
-        members = []
-        for opens, closes in windows:
-            members.append(len(clients))
-            clients.append(
-                pyvrp.Client(
-                    location=node,
-                    delivery=[int(problem.demand_g[node])],
-                    service_duration=int(problem.service_s[node]),
-                    tw_early=int(opens),
-                    tw_late=int(closes),
-                    prize=0 if required else prize,
-                    required=required and len(windows) == 1,
-                    group=len(groups) if len(windows) > 1 else None,
-                )
-            )
-            client_node.append(node)
-        if len(windows) > 1:
-            groups.append(pyvrp.ClientGroup(members, required=required))
-        node_clients[node] = members
+    clients, client_node, node_clients, groups = _pyvrp_clients(problem, required, prize)
     # A large fixed cost keeps vans home; the small steps between the vans' fixed costs only
     # say the first-listed drive first, which the order of a type's vans says as well. One
     # type for vans alike but for those steps: 25 types of one van each found a van more on
@@ -321,23 +293,7 @@ def _pyvrp_model(problem: RoutingInput, required: bool) -> _PyvrpModel:
     matrices: dict[int, int] = {}
     distance_matrices: list[IntMatrix] = []
     vehicle_types = []
-    # the depot to start and end at, the vans' positions under way, then one at the depot's
-    # place per reload time (its service)
-    depots = [pyvrp.Depot(location=0, tw_early=0, tw_late=horizon)]
-    start_depot: dict[int, int] = {0: 0}
-    for vehicle in problem.vehicles:
-        if vehicle.start not in start_depot:
-            start_depot[vehicle.start] = len(depots)
-            depots.append(pyvrp.Depot(location=vehicle.start, tw_early=0, tw_late=horizon))
-    reload_depot: dict[int, int] = {}
-    for vehicle in problem.vehicles:
-        if vehicle.max_reloads and vehicle.reload_s not in reload_depot:
-            reload_depot[vehicle.reload_s] = len(depots)
-            depots.append(
-                pyvrp.Depot(
-                    location=0, tw_early=0, tw_late=horizon, service_duration=vehicle.reload_s
-                )
-            )
+    depots, start_depot, reload_depot = _pyvrp_depots(problem)
     for vans in kinds.values():
         vehicle = problem.vehicles[vans[0]]
         key = id(vehicle.arc_cost)
@@ -370,6 +326,68 @@ def _pyvrp_model(problem: RoutingInput, required: bool) -> _PyvrpModel:
         groups,
     )
     return _PyvrpModel(data, client_node, node_clients, list(kinds.values()))
+
+
+def _pyvrp_clients(
+    problem: RoutingInput, required: bool, prize: int
+) -> tuple[list[pyvrp.Client], list[int], dict[int, list[int]], list[pyvrp.ClientGroup]]:
+    """PyVRP's clients: one per window of each place a van can serve (a group of them when it
+    has several, of which a route visits one), required or for ``prize``; the place of each,
+    and the clients of each place."""
+    horizon = int(problem.horizon_s)
+    never = horizon + 1
+    clients: list[pyvrp.Client] = []
+    client_node: list[int] = []
+    node_clients: dict[int, list[int]] = {}
+    groups: list[pyvrp.ClientGroup] = []
+    for node in range(1, problem.travel_s.shape[0]):
+        windows = problem.windows_s[node] or [(0, horizon)]
+        if windows[0][0] >= never:  # no van can ever serve it (or a van sets off there)
+            continue
+        members = []
+        for opens, closes in windows:
+            members.append(len(clients))
+            clients.append(
+                pyvrp.Client(
+                    location=node,
+                    delivery=[int(problem.demand_g[node])],
+                    service_duration=int(problem.service_s[node]),
+                    tw_early=int(opens),
+                    tw_late=int(closes),
+                    prize=0 if required else prize,
+                    required=required and len(windows) == 1,
+                    group=len(groups) if len(windows) > 1 else None,
+                )
+            )
+            client_node.append(node)
+        if len(windows) > 1:
+            groups.append(pyvrp.ClientGroup(members, required=required))
+        node_clients[node] = members
+    return clients, client_node, node_clients, groups
+
+
+def _pyvrp_depots(
+    problem: RoutingInput,
+) -> tuple[list[pyvrp.Depot], dict[int, int], dict[int, int]]:
+    """The depot to start and end at, the vans' positions under way, then one at the depot's
+    place per reload time (its service); the depot each start place and reload time is."""
+    horizon = int(problem.horizon_s)
+    depots = [pyvrp.Depot(location=0, tw_early=0, tw_late=horizon)]
+    start_depot: dict[int, int] = {0: 0}
+    for vehicle in problem.vehicles:
+        if vehicle.start not in start_depot:
+            start_depot[vehicle.start] = len(depots)
+            depots.append(pyvrp.Depot(location=vehicle.start, tw_early=0, tw_late=horizon))
+    reload_depot: dict[int, int] = {}
+    for vehicle in problem.vehicles:
+        if vehicle.max_reloads and vehicle.reload_s not in reload_depot:
+            reload_depot[vehicle.reload_s] = len(depots)
+            depots.append(
+                pyvrp.Depot(
+                    location=0, tw_early=0, tw_late=horizon, service_duration=vehicle.reload_s
+                )
+            )
+    return depots, start_depot, reload_depot
 
 
 def _cost_per_s(problem: RoutingInput) -> float:

@@ -62,7 +62,6 @@ def test_the_stops_a_battery_left_out_are_served_with_a_charger(one_van):
             assert "charging did not let a van serve it" in u.detail
 
 
-
 def test_a_stop_charging_cannot_save_says_charging_was_tried():
     """A charger 140 km away: the stops the battery leaves out stay out, and each says that
     charging was tried (a dispatcher would otherwise add chargers in vain)."""
@@ -73,6 +72,7 @@ def test_a_stop_charging_cannot_save_says_charging_was_tried():
     assert len(left) >= 10
     assert all("charging did not let a van serve it" in u.detail for u in left)
     assert not any(r.plan.charges for r in result.routes)
+
 
 def two_clusters() -> FleetProblem:
     """Two vans of 10 kWh until 14:00, 12 stops 10 km out east and 12 west (8 min each):
