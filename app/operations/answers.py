@@ -37,7 +37,7 @@ def weather(used: Weather, source: WeatherSource, days: list[DayWeather]) -> Wea
         t_min_c=used.t_min_c,
         t_max_c=used.t_max_c,
         source=source,
-        days=[DayWeatherOut(date=d.date, t_min_c=d.t_min_c, t_max_c=d.t_max_c) for d in days],
+        days=[DayWeatherOut(**dict(d)) for d in days],
     )
 
 

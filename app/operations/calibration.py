@@ -25,7 +25,6 @@ from core.calibration.fit import (
     FITTABLE,
     Calibration,
     MeasuredTrip,
-    TripFit,
     calibrate,
     check_trips,
 )
@@ -100,39 +99,16 @@ def profile_base(request: CalibrationRequest, van: VanParams, settings: Settings
     return van.model_copy(update={"payload_kg": base.payload_kg})
 
 
-def _finite(value: float) -> float | None:
-    return value if math.isfinite(value) else None
-
-
-def _trip_out(trip: TripFit) -> TripFitOut:
-    return TripFitOut(
-        id=trip.id,
-        role=trip.role,  # type: ignore[arg-type]
-        r2=_finite(trip.r2),
-        rmse_w=trip.rmse_w,
-        energy_error_pct=_finite(trip.energy_error_pct),
-    )
-
-
 def answer(fit: Calibration) -> CalibrationResponse:
     """The fit as the endpoint answers it."""
     vehicle = {p.name: p.value for p in fit.parameters if FITTABLE[p.name] is not CargoBoxParams}
     box = {p.name: p.value for p in fit.parameters if FITTABLE[p.name] is CargoBoxParams}
     return CalibrationResponse(
         id=str(uuid.uuid4()),
-        parameters={
-            p.name: FittedParameterOut(
-                value=p.value,
-                initial=p.initial,
-                std_error=p.std_error,
-                ci95=p.ci95,
-                identifiable=p.identifiable,
-            )
-            for p in fit.parameters
-        },
-        trips=[_trip_out(t) for t in fit.trips],
+        parameters={p.name: FittedParameterOut(**dict(p)) for p in fit.parameters},
+        trips=[TripFitOut(**dict(t)) for t in fit.trips],
         validation=ValidationOut(
-            method=fit.validation_method, trips=[_trip_out(t) for t in fit.validation]
+            method=fit.validation_method, trips=[TripFitOut(**dict(t)) for t in fit.validation]
         ),
         vehicle=vehicle,
         cargo_box=box,

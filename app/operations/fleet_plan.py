@@ -72,7 +72,7 @@ def fleet_response(
             )
             for route in result.routes
         ],
-        unassigned=[UnassignedOut(**vars(u)) for u in result.unassigned],
+        unassigned=[UnassignedOut(**dict(u)) for u in result.unassigned],
         totals=FleetTotals(
             distance_m=result.distance_m,
             duration_s=result.duration_s,

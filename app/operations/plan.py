@@ -55,25 +55,26 @@ def plan_response(
     result: PlanResult, include_geometry: bool = False, include_profile: bool = False
 ) -> PlanResponse:
     """The answer of ``POST /v1/plans`` for a planned round."""
-    legs = []
-    for leg in result.legs:
-        fields = vars(leg) | {"energy_kwh": energy(leg.energy_kwh)}
-        fields["geometry"] = LineString(coordinates=leg.geometry) if include_geometry else None
-        legs.append(LegOut(**fields))
-    stops = [
-        StopOut(
-            **{k: v for k, v in vars(stop).items() if k not in ("lat", "lon")}
-            | {"energy_kwh": energy(stop.energy_kwh)}
+    legs = [
+        LegOut(
+            **dict(leg)
+            | {
+                "energy_kwh": energy(leg.energy_kwh),
+                "geometry": LineString(coordinates=leg.geometry) if include_geometry else None,
+            }
         )
-        for stop in result.stops
+        for leg in result.legs
+    ]
+    stops = [
+        StopOut(**dict(stop) | {"energy_kwh": energy(stop.energy_kwh)}) for stop in result.stops
     ]
     return PlanResponse(
         tour=result.tour,
         legs=legs,
         stops=stops,
-        charges=[ChargeOut(**vars(charge)) for charge in result.charges],
-        reloads=[ReloadOut(**vars(reload)) for reload in result.reloads],
-        breaks=[BreakOut(**vars(rest)) for rest in result.breaks],
+        charges=[ChargeOut(**dict(charge)) for charge in result.charges],
+        reloads=[ReloadOut(**dict(reload)) for reload in result.reloads],
+        breaks=[BreakOut(**dict(rest)) for rest in result.breaks],
         totals=Totals(
             distance_m=result.distance_m,
             duration_s=result.duration_s,
@@ -89,14 +90,7 @@ def plan_response(
             result.minutes_above_product_limit,
             result.product_limit_c,
         ),
-        solver=SolverOut(
-            status=result.solved.status,
-            objective=result.objective,
-            objective_value=result.solved.objective_value,
-            runtime_s=result.solved.runtime_s,
-            stopped_by=result.solved.stopped_by,
-            proven=list(result.solved.proven),
-        ),
+        solver=SolverOut(**dict(result.solved), objective=result.objective),
         distance_source=result.distance_source,
         warnings=result.warnings,
         attribution=attribution(result.distance_source),
@@ -105,12 +99,7 @@ def plan_response(
 
 
 def day_profile(profile: DayProfile) -> DayProfileOut:
-    return DayProfileOut(
-        time=profile.time,
-        soc=profile.soc,
-        energy_kwh=EnergySeries(**profile.energy_kwh),
-        box_temperature_c=profile.box_temperature_c,
-    )
+    return DayProfileOut(**dict(profile) | {"energy_kwh": EnergySeries(**profile.energy_kwh)})
 
 
 def answer(request: PlanRequest, result: PlanResult) -> PlanResponse:
@@ -153,14 +142,14 @@ def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> Plan
         features.append(
             Feature(
                 geometry=Point(coordinates=(charge.lon, charge.lat)),
-                properties={"kind": "charge"} | ChargeOut(**vars(charge)).model_dump(mode="json"),
+                properties={"kind": "charge"} | ChargeOut(**dict(charge)).model_dump(mode="json"),
             )
         )
     for reload in result.reloads:
         features.append(
             Feature(
                 geometry=Point(coordinates=(depot_lon, depot_lat)),
-                properties={"kind": "reload"} | ReloadOut(**vars(reload)).model_dump(mode="json"),
+                properties={"kind": "reload"} | ReloadOut(**dict(reload)).model_dump(mode="json"),
             )
         )
     for index, leg in enumerate(result.legs):

@@ -73,7 +73,7 @@ def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepRe
     return SpeedSweepResponse(
         points=[
             SpeedPointOut(
-                speed_kmh=p.speed_kmh, energy_wh_per_km=ConsumptionWhPerKm(**p.energy_wh_per_km)
+                **dict(p) | {"energy_wh_per_km": ConsumptionWhPerKm(**p.energy_wh_per_km)}
             )
             for p in sweep.points
         ],
@@ -137,7 +137,7 @@ def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosRes
         tour=grid.tour,
         baseline_energy_kwh=energy(grid.baseline_energy_kwh),
         cells=[
-            ScenarioCellOut(**(vars(c) | {"energy_kwh": energy(c.energy_kwh)})) for c in grid.cells
+            ScenarioCellOut(**dict(c) | {"energy_kwh": energy(c.energy_kwh)}) for c in grid.cells
         ],
     )
 

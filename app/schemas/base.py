@@ -4,7 +4,6 @@ battery, weather and box answers, and the problem document."""
 
 from __future__ import annotations
 
-import datetime as dt
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, get_args
 
 from pydantic import (
@@ -33,7 +32,7 @@ from core.params import (
     inside_validation,
 )
 from core.physics.simulate import CONSUMERS
-from core.physics.weather import WeatherSource
+from core.physics.weather import DayWeather, WeatherSource
 from core.routing.geo import DistanceSource
 
 
@@ -354,12 +353,8 @@ class BatteryOut(ApiModel):
     )
 
 
-class DayWeatherOut(ApiModel):
+class DayWeatherOut(ApiModel, DayWeather):
     """One local day's temperatures."""
-
-    date: dt.date = Field(..., description="The local day.")
-    t_min_c: float = Field(..., description="Lowest temperature of the day's moments [°C].")
-    t_max_c: float = Field(..., description="Highest temperature of the day's moments [°C].")
 
 
 class WeatherOut(ApiModel):

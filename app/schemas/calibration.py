@@ -7,7 +7,14 @@ from typing import Annotated, Literal
 from pydantic import Field
 
 from app.schemas.base import ApiModel, NotNull, VanRequest, absent
-from core.calibration.fit import CHANNELS, FITTABLE, FitParameter, FittableName
+from core.calibration.fit import (
+    CHANNELS,
+    FITTABLE,
+    FitParameter,
+    FittableName,
+    FittedParameter,
+    TripFit,
+)
 from core.params import MAX_INTERVALS, MAX_TRACE_SAMPLES, DoorOpening, IsoDateTime, Location
 
 #: Most trips in one calibration.
@@ -91,41 +98,12 @@ class CalibrationRequest(VanRequest):
         return [p if isinstance(p, FitParameter) else FitParameter(name=p) for p in self.parameters]
 
 
-class FittedParameterOut(ApiModel):
+class FittedParameterOut(ApiModel, FittedParameter):
     """One fitted parameter."""
 
-    value: float = Field(..., description="The fitted value.")
-    initial: float = Field(..., description="The starting van's value.")
-    std_error: float | None = Field(
-        ...,
-        description="Standard error at the solution: a sandwich with the Newey–West covariance "
-        "of the residuals (robust to noise that grows with the power and is correlated in "
-        "time); null where no interval is given.",
-    )
-    ci95: tuple[float, float] | None = Field(
-        ...,
-        description="95 % interval [low, high] (fixed-b critical value, Kiefer & Vogelsang "
-        "2005), within the parameter's bounds; null where the data cannot give one: the trips "
-        "do not move the parameter, or it would absorb the cab's and box's draw of trips "
-        "without ambient_c (a warning says so).",
-    )
-    identifiable: bool = Field(
-        ...,
-        description="Whether the data tell it apart: an interval given, narrower than its "
-        "value, and no correlation above 0.95 with another fitted parameter.",
-    )
 
-
-class TripFitOut(ApiModel):
+class TripFitOut(ApiModel, TripFit):
     """How the fitted model follows one trip."""
-
-    id: str = Field(..., description="The trip.")
-    role: Literal["fit", "validation"] = Field(..., description="fit or validation.")
-    r2: float | None = Field(..., description="Coefficient of determination of the power [–].")
-    rmse_w: float = Field(..., description="RMS error of the power over its channels [W].")
-    energy_error_pct: float | None = Field(
-        ..., description="Simulated against measured energy [%]."
-    )
 
 
 class ValidationOut(ApiModel):

@@ -11,7 +11,7 @@ from core.planning.model import (
     FleetFields,
     FleetStatus,
     ShiftFields,
-    UnassignedReason,
+    Unassigned,
     vehicles_field,
 )
 from core.routing.effort import SearchEnd
@@ -34,18 +34,8 @@ class FleetRouteOut(PlanResponse):
     vehicle_id: str = Field(..., description="The van that drives this route.")
 
 
-class UnassignedOut(ApiModel):
+class UnassignedOut(ApiModel, Unassigned):
     """A stop no van serves."""
-
-    id: str = Field(..., description="The stop's id.")
-    reason: UnassignedReason = Field(
-        ...,
-        description="time_window (no van reaches it inside a window), capacity (no payload "
-        "left or too heavy), battery (the charge would fall below a reserve), shift (no van "
-        "back in time), unreachable (no road) or time_limit (the search ran out of time before "
-        "it placed the stop; it may fit with more work: work_s or a longer time_limit_s).",
-    )
-    detail: str = Field(..., description="Why, in a sentence.")
 
 
 class FleetTotals(ApiModel):

@@ -9,7 +9,7 @@ from pydantic import Field
 from app.schemas.base import ApiModel, ConsumptionWhPerKm, EnergyKwh, VanRequest
 from app.schemas.plans import PlanRequest
 from core.params import ClockTime, IsoDate, Location, TrafficDensity, Weather, clock_field
-from core.planning.studies import Season
+from core.planning.studies import ScenarioCell, Season, SpeedPoint
 
 
 class SpeedSweepRequest(VanRequest):
@@ -41,11 +41,10 @@ class SpeedSweepRequest(VanRequest):
     )
 
 
-class SpeedPointOut(ApiModel):
+class SpeedPointOut(ApiModel, SpeedPoint):
     """One speed of the sweep."""
 
-    speed_kmh: float = Field(..., description="The trip's mean speed [km/h].")
-    energy_wh_per_km: ConsumptionWhPerKm = Field(
+    energy_wh_per_km: ConsumptionWhPerKm = Field(  # type: ignore[assignment]
         ..., description="Energy per km of each consumer at that speed [Wh/km]."
     )
 
@@ -85,17 +84,12 @@ class ScenariosRequest(ApiModel):
     )
 
 
-class ScenarioCellOut(ApiModel):
+class ScenarioCellOut(ApiModel, ScenarioCell):
     """One cell of the grid."""
 
-    season: str = Field(..., description="The season's name.")
-    driver_aggressiveness: float = Field(..., description="ε_d of the cell [–].")
-    traffic_density: float | None = Field(
-        ..., description="ε_t of the cell [–]; null: each street type's default."
+    energy_kwh: EnergyKwh = Field(  # type: ignore[assignment]
+        ..., description="Energy of each consumer in this cell [kWh]."
     )
-    energy_kwh: EnergyKwh = Field(..., description="Energy of each consumer in this cell [kWh].")
-    change_vs_baseline_pct: float = Field(..., description="Total energy against the baseline.")
-    feasible: bool = Field(..., description="The battery holds out with its reserve.")
 
 
 class ScenariosResponse(ApiModel):

@@ -44,7 +44,7 @@ from core.params import (
     VehicleParams,
     Weather,
 )
-from core.params.base import Params
+from core.params.base import Params, Result
 from core.physics.simulate import (
     MAX_ABS_GRADE,
     MAX_PAYLOAD_KG,
@@ -153,30 +153,52 @@ class MeasuredTrip:
     door_openings: Sequence[DoorOpening] = ()
 
 
-@dataclass(frozen=True)
-class FittedParameter:
+class FittedParameter(Result):
     """One fitted parameter: its value, where it started, its standard error, its 95 %
     interval and whether the data tell it apart."""
 
-    name: str
-    value: float
-    initial: float
-    std_error: float | None
-    ci95: tuple[float, float] | None
-    identifiable: bool
+    name: str = Field(..., description="The parameter, as the request names it.")
+    value: float = Field(..., description="The fitted value.")
+    initial: float = Field(..., description="The starting van's value.")
+    std_error: float | None = Field(
+        ...,
+        description="Standard error at the solution: a sandwich with the Newey–West covariance "
+        "of the residuals (robust to noise that grows with the power and is correlated in "
+        "time); null where no interval is given.",
+    )
+    ci95: tuple[float, float] | None = Field(
+        ...,
+        description="95 % interval [low, high] (fixed-b critical value, Kiefer & Vogelsang "
+        "2005), within the parameter's bounds; null where the data cannot give one: the trips "
+        "do not move the parameter, or it would absorb the cab's and box's draw of trips "
+        "without ambient_c (a warning says so).",
+    )
+    identifiable: bool = Field(
+        ...,
+        description="Whether the data tell it apart: an interval given, narrower than its "
+        "value, and no correlation above 0.95 with another fitted parameter.",
+    )
 
 
-@dataclass(frozen=True)
-class TripFit:
-    """How well the model with the fitted parameters follows one trip: the coefficient of
-    determination and the RMS error of the power [W] over every measured channel, and the
-    simulated energy's error against the measured [%]."""
+#: What a trip was to the fit: fitted to, or predicted (validation).
+TripRole = Literal["fit", "validation"]
 
-    id: str
-    role: str
-    r2: float
-    rmse_w: float
-    energy_error_pct: float
+
+class TripFit(Result):
+    """How the model with the fitted parameters follows one trip."""
+
+    id: str = Field(..., description="The trip.")
+    role: TripRole = Field(..., description="fit or validation.")
+    r2: float | None = Field(
+        ...,
+        description="Coefficient of determination of the power [–]; null when the measured "
+        "power does not vary.",
+    )
+    rmse_w: float = Field(..., description="RMS error of the power over its channels [W].")
+    energy_error_pct: float | None = Field(
+        ...,
+        description="Simulated against measured energy [%]; null when no energy was measured.",
+    )
 
 
 @dataclass(frozen=True)
@@ -616,12 +638,12 @@ def _uncertainty(
         )
         fitted.append(
             FittedParameter(
-                parameter.name,
-                value,
-                parameter.initial,
-                error if given else None,
-                interval,
-                identifiable,
+                name=parameter.name,
+                value=value,
+                initial=parameter.initial,
+                std_error=error if given else None,
+                ci95=interval,
+                identifiable=identifiable,
             )
         )
     return _Uncertainty(fitted, correlation)
@@ -690,18 +712,24 @@ def _warnings(
 SEPARATING_SPEEDS_MPS = 10.0
 
 
-def _trip_fit(van: VanParams, trip: _Resampled, role: str) -> TripFit:
+def _trip_fit(van: VanParams, trip: _Resampled, role: TripRole) -> TripFit:
     result = _simulated(van, trip)
     simulated = np.concatenate([_channel_w(result, c, m.size) for c, m in trip.measured_w.items()])
     measured = np.concatenate(list(trip.measured_w.values()))
     error = simulated - measured
     spread = float(np.sum((measured - measured.mean()) ** 2))
-    r2 = 1.0 - float(np.sum(error**2)) / spread if spread > 0 else math.nan
+    r2 = 1.0 - float(np.sum(error**2)) / spread if spread > 0 else None
     measured_j = float(np.sum(measured)) * trip.dt_s
     simulated_j = float(np.sum(simulated)) * trip.dt_s
     # No energy measured (a channel of zeros): no relative error to give.
-    energy_error = (simulated_j - measured_j) / abs(measured_j) * 100 if measured_j else math.nan
-    return TripFit(trip.trip.id, role, r2, float(np.sqrt(np.mean(error**2))), energy_error)
+    energy_error = (simulated_j - measured_j) / abs(measured_j) * 100 if measured_j else None
+    return TripFit(
+        id=trip.trip.id,
+        role=role,
+        r2=r2,
+        rmse_w=float(np.sqrt(np.mean(error**2))),
+        energy_error_pct=energy_error,
+    )
 
 
 def _cross_validation(

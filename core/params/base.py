@@ -165,6 +165,13 @@ def few_unknown(model: type[BaseModel], data: Any) -> Any:
     return {key: value for key, value in data.items() if key not in dropped}
 
 
+class Result(BaseModel):
+    """Base of the results an answer shows field by field: frozen, each field described once
+    here (the web layer's answer models derive from these). NaN passes (the answer refuses it)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
 class Params(BaseModel):
     """Base of every parameter model: frozen, no unknown fields, no NaN or infinity."""
 

@@ -20,11 +20,12 @@ from typing import Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
+from pydantic import Field
 
 from core.arrays import FloatArray
 from core.clock import LocalClock
 from core.exceptions import InvalidParameterError, ServiceUnavailableError
-from core.params import Weather
+from core.params import Result, Weather
 
 WeatherSource = Literal["request", "forecast", "archive", "climatology"]
 
@@ -149,13 +150,12 @@ class HourlyWeather:
 Forecast = Weather | HourlyWeather
 
 
-@dataclass(frozen=True)
-class DayWeather:
-    """The extremes of one local day of the round [°C]."""
+class DayWeather(Result):
+    """One local day's temperatures."""
 
-    date: dt.date
-    t_min_c: float
-    t_max_c: float
+    date: dt.date = Field(..., description="The local day.")
+    t_min_c: float = Field(..., description="Lowest temperature of the day's moments [°C].")
+    t_max_c: float = Field(..., description="Highest temperature of the day's moments [°C].")
 
 
 @dataclass(frozen=True)
@@ -212,9 +212,9 @@ def conditions(weather: Forecast | None, clock: LocalClock, lat: float) -> Condi
         north = np.interp(clock.utc_s, t, weather.wind_speed_mps * np.cos(radians))
         days = [
             DayWeather(
-                date,
-                float(ambient[clock.day_index == index].min()),
-                float(ambient[clock.day_index == index].max()),
+                date=date,
+                t_min_c=float(ambient[clock.day_index == index].min()),
+                t_max_c=float(ambient[clock.day_index == index].max()),
             )
             for index, date in enumerate(clock.dates)
             if np.any(clock.day_index == index)
@@ -242,7 +242,10 @@ def conditions(weather: Forecast | None, clock: LocalClock, lat: float) -> Condi
         diffuse_horizontal_w_m2=None,
         wind_from_east_mps=calm,
         wind_from_north_mps=calm,
-        days=[DayWeather(d, w.t_min_c, w.t_max_c) for d, w in zip(clock.dates, daily, strict=True)],
+        days=[
+            DayWeather(date=d, t_min_c=w.t_min_c, t_max_c=w.t_max_c)
+            for d, w in zip(clock.dates, daily, strict=True)
+        ],
         source=source,
     )
 

@@ -27,6 +27,7 @@ from core.params import (
     Objective,
     Params,
     Place,
+    Result,
     RoadMatrix,
     Stop,
     StreetTypeName,
@@ -37,6 +38,7 @@ from core.params import (
 )
 from core.physics.battery import BatteryVerdict
 from core.physics.weather import DayWeather, WeatherSource
+from core.planning.itinerary import Itinerary
 from core.routing.effort import Effort, SearchEnd
 from core.routing.geo import DistanceSource, build_legs
 from core.routing.tsp import SolverStatus
@@ -410,131 +412,154 @@ def place_field(index: int) -> str:
 # --- results ------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class LegResult:
-    """One driven leg of the round.
+class LegResult(Result):
+    """One driven leg of the round."""
 
-    ``geometry`` is the road as ``(lon, lat)`` points: the router's polyline, or the straight
-    line between the two places when the distances are an estimate or the client's.
-    """
+    from_id: str = Field(..., description="Where the leg starts: the depot's or a stop's id.")
+    to_id: str = Field(..., description="Where the leg ends: a stop's or the depot's id.")
+    depart: dt.datetime = Field(..., description="Departure, local time with offset.")
+    arrive: dt.datetime = Field(..., description="Arrival, local time with offset.")
+    distance_m: float = Field(..., description="Distance [m].")
+    duration_s: float = Field(..., description="Driving time [s].")
+    street_type: StreetTypeName = Field(
+        ...,
+        description="urban, highway or expressway: by the leg's speeds (router or client) "
+        "or its length (estimate).",
+    )
+    grade: float = Field(..., description="Mean grade, rise over run [–].")
+    energy_kwh: dict[str, float] = Field(
+        ..., description="Energy of each consumer while driving this leg [kWh]."
+    )
+    soc_start: float = Field(..., description="State of charge at departure [–].")
+    soc_end: float = Field(..., description="State of charge on arrival [–].")
+    geometry: list[tuple[float, float]] = Field(
+        ...,
+        description="The leg's road as [lon, lat] points: the router's, or the straight line "
+        "between the two places when the distances are an estimate or the client's.",
+    )
 
-    from_id: str
-    to_id: str
-    depart: dt.datetime
-    arrive: dt.datetime
-    distance_m: float
-    duration_s: float
-    street_type: StreetTypeName
-    grade: float
-    energy_kwh: dict[str, float]
-    soc_start: float
-    soc_end: float
-    geometry: list[tuple[float, float]]
 
-
-@dataclass(frozen=True)
-class StopResult:
+class StopResult(Result):
     """One stop of the round, in visiting order."""
 
-    id: str
-    arrival: dt.datetime
-    service_start: dt.datetime
-    wait_s: float
-    departure: dt.datetime
-    door_heat_kwh: float
-    payload_after_kg: float
-    energy_kwh: dict[str, float]
-    soc_arrival: float
-    soc_departure: float
-    snap_distance_m: float | None
-    lat: float
-    lon: float
+    id: str = Field(..., description="The stop's id.")
+    arrival: dt.datetime = Field(..., description="Arrival, local time with UTC offset.")
+    service_start: dt.datetime = Field(
+        ..., description="Service begins (inside a time window), local time with UTC offset."
+    )
+    wait_s: float = Field(
+        ..., description="Waiting for the stop's time window to open, parked [s]."
+    )
+    departure: dt.datetime = Field(
+        ..., description="Departure after the service, local time with UTC offset."
+    )
+    door_heat_kwh: float = Field(..., description="Heat let in through the open door [kWh].")
+    payload_after_kg: float = Field(..., description="Payload when leaving the stop [kg].")
+    energy_kwh: dict[str, float] = Field(..., description="Energy used while standing here [kWh].")
+    soc_arrival: float = Field(..., description="State of charge on arrival [–].")
+    soc_departure: float = Field(..., description="State of charge when leaving [–].")
+    snap_distance_m: float | None = Field(
+        None,
+        description="Distance from the stop to the road the router snapped it to [m]; null "
+        "without a router.",
+    )
+    lat: float = Field(..., description="The stop's latitude, as requested [°].")
+    lon: float = Field(..., description="The stop's longitude, as requested [°].")
 
 
-@dataclass(frozen=True)
-class ChargeResult:
-    """One charge of the round: where (``charger_id``, "depot" for the depot's), when, the
-    state of charge before and after [–], the energy drawn from the grid for the battery and
-    the consumers meanwhile and the energy stored in the battery [kWh], the minutes plugged
-    in, what the grid energy costs at the charger's price, and where the charger is [°]."""
+class ChargeResult(Result):
+    """One charge of the round, where it happens in the timeline."""
 
-    charger_id: str
-    arrive: dt.datetime
-    depart: dt.datetime
-    soc_before: float
-    soc_after: float
-    grid_kwh: float
-    battery_kwh: float
-    minutes: float
-    cost: float
-    lat: float
-    lon: float
-
-
-@dataclass(frozen=True)
-class ReloadResult:
-    """A return to the depot to reload: when the van arrives and leaves, and the payload it
-    leaves with [kg]."""
-
-    arrive: dt.datetime
-    depart: dt.datetime
-    payload_kg: float
+    charger_id: str = Field(
+        ..., description="Where: a charger's id, or \"depot\" for the depot's charger."
+    )
+    arrive: dt.datetime = Field(..., description="Arrival at the charger, local time.")
+    depart: dt.datetime = Field(
+        ..., description="Departure, plugging in and out included, local time."
+    )
+    soc_before: float = Field(..., description="State of charge when the charge starts [–].")
+    soc_after: float = Field(..., description="State of charge when it ends [–].")
+    grid_kwh: float = Field(
+        ...,
+        description="Energy from the grid: the charge (battery_kwh / charging_efficiency) and "
+        "the cab and refrigeration, which run from the grid while plugged in [kWh].",
+    )
+    battery_kwh: float = Field(..., description="Energy stored in the battery [kWh].")
+    minutes: float = Field(..., description="Minutes charging (plugging in and out aside).")
+    cost: float = Field(..., description="grid_kwh at the charger's price_per_kwh.")
+    lat: float = Field(..., description="The charger's latitude [°].")
+    lon: float = Field(..., description="The charger's longitude [°].")
 
 
-@dataclass(frozen=True)
-class BreakResult:
-    """A driver's break: when, and why ("eu-561" or "fixed")."""
+class ReloadResult(Result):
+    """A return to the depot to reload, where it happens in the timeline."""
 
-    start: dt.datetime
-    end: dt.datetime
-    kind: str
+    arrive: dt.datetime = Field(..., description="Arrival at the depot, local time.")
+    depart: dt.datetime = Field(..., description="Departure with the new load, local time.")
+    payload_kg: float = Field(..., description="Payload aboard when it leaves [kg].")
 
 
-@dataclass(frozen=True)
-class DayProfile:
-    """The round minute by minute: cumulative energy per consumer over the clock time (paper
-    Fig. 8), the state of charge and the cargo air's temperature.
+class BreakResult(Result):
+    """A driver's break, parked (cab and refrigeration drawing)."""
 
-    Attributes
-    ----------
-    time
-        Moments every minute from departure to return, local time.
-    energy_kwh
-        Energy used since departure at each moment, per consumer and ``total`` [kWh].
-    soc
-        State of charge at each moment [–].
-    box_temperature_c
-        Cargo-air temperature at each moment [°C]; None for a steady box (held at its
-        set-point).
-    """
+    start: dt.datetime = Field(..., description="Start, local time.")
+    end: dt.datetime = Field(..., description="End, local time.")
+    kind: str = Field(
+        ...,
+        description='"eu-561": the driving limit of Regulation (EC) No 561/2006 (also a wait '
+        'or a charge of 45 min that counts as the break); "fixed": one of the listed breaks.',
+    )
 
-    time: list[dt.datetime]
-    energy_kwh: dict[str, list[float]]
-    soc: list[float]
-    box_temperature_c: list[float] | None
+
+class DayProfile(Result):
+    """The round minute by minute, from departure to return (the paper's Fig. 8)."""
+
+    time: list[dt.datetime] = Field(..., description="Each minute, local time with UTC offset.")
+    energy_kwh: dict[str, list[float]] = Field(
+        ..., description="Energy of each consumer and the total since departure, cumulative [kWh]."
+    )
+    soc: list[float] = Field(..., description="State of charge at each moment [–].")
+    box_temperature_c: list[float] | None = Field(
+        ...,
+        description="Cargo-air temperature at each moment [°C] (dynamic box; null in steady "
+        "mode, where the unit holds the set-point).",
+    )
 
 
 #: The parts of a plan a proof may cover: the order of its stops.
 ProvenPart = Literal["order"]
 
 
-@dataclass(frozen=True)
-class Solved:
-    """How the plan was found: the solver's status (``optimal`` only when every part of it
-    is proven: the order, and no charge or reload placed by a heuristic), the objective's
-    value in its unit (m, s or Wh), the search time [s], how the searches stopped, and the
-    parts that carry a proof."""
+class Solved(Result):
+    """How the plan was found."""
 
-    status: SolverStatus
-    objective_value: float
-    runtime_s: float
-    stopped_by: SearchEnd = "work"
-    proven: tuple[ProvenPart, ...] = ()
+    status: SolverStatus = Field(
+        ...,
+        description="optimal: the whole answer is proven optimal for its objective — the order "
+        "proven over every arc, and no charge or reload placed by a heuristic; feasible: the "
+        "best found (see proven for the parts that carry a proof); fixed_order: keep_order.",
+    )
+    objective_value: float = Field(..., description="Of the tour, in m, s or Wh (estimate).")
+    runtime_s: float = Field(
+        ..., description="Time the search took [s]. A timing field: it differs between runs."
+    )
+    stopped_by: SearchEnd = Field(
+        "work",
+        description="work: the search did all its work (work_s); proof: it proved its optimum "
+        "first; time_limit: time_limit_s stopped it first — the answer may then differ on a "
+        "retry (a warning says so). The same request gives the same answer unless time_limit.",
+    )
+    proven: tuple[ProvenPart, ...] = Field(
+        (),
+        description="The parts of the answer that carry a proof: order (the stops' order is "
+        "the optimum of the round trip) — also when charges or reloads were placed after it.",
+    )
 
 
 @dataclass(frozen=True)
 class PlanResult:
-    """The solved and simulated round."""
+    """The solved and simulated round, and the itinerary it drove (its charges as planned, the
+    opening hours from its departure)."""
 
     tour: list[str]
     legs: list[LegResult]
@@ -561,6 +586,7 @@ class PlanResult:
     objective: Objective
     profile: DayProfile
     late_stops: list[str]
+    itinerary: Itinerary
     charges: list[ChargeResult] = field(default_factory=list)
     reloads: list[ReloadResult] = field(default_factory=list)
     breaks: list[BreakResult] = field(default_factory=list)
@@ -571,13 +597,18 @@ UnassignedReason = Literal[
 ]
 
 
-@dataclass(frozen=True)
-class Unassigned:
-    """A stop no van serves, why (``reason``) and a sentence that says so (``detail``)."""
+class Unassigned(Result):
+    """A stop no van serves."""
 
-    id: str
-    reason: UnassignedReason
-    detail: str
+    id: str = Field(..., description="The stop's id.")
+    reason: UnassignedReason = Field(
+        ...,
+        description="time_window (no van reaches it inside a window), capacity (no payload "
+        "left or too heavy), battery (the charge would fall below a reserve), shift (no van "
+        "back in time), unreachable (no road) or time_limit (the search ran out of time before "
+        "it placed the stop; it may fit with more work: work_s or a longer time_limit_s).",
+    )
+    detail: str = Field(..., description="Why, in a sentence.")
 
 
 @dataclass(frozen=True)

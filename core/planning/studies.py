@@ -20,6 +20,7 @@ from core.params import (
     IsoDate,
     Location,
     Params,
+    Result,
     RoadMatrix,
     StreetType,
     VanParams,
@@ -38,12 +39,13 @@ MIN_SWEEP_DISTANCE_M = 100.0
 SWEEP_SHAPE = "highway"
 
 
-@dataclass(frozen=True)
-class SpeedPoint:
-    """One speed of a sweep: energy per distance of each consumer and ``total`` [Wh/km]."""
+class SpeedPoint(Result):
+    """One speed of the sweep."""
 
-    speed_kmh: float
-    energy_wh_per_km: dict[str, float]
+    speed_kmh: float = Field(..., description="The trip's mean speed [km/h].")
+    energy_wh_per_km: dict[str, float] = Field(
+        ..., description="Energy per km of each consumer and the total at that speed [Wh/km]."
+    )
 
 
 @dataclass(frozen=True)
@@ -117,7 +119,7 @@ def speed_sweep(
         )
         result = simulate(trace, 1.0, start, location, van, weather=weather)
         per_km = {k: v * 1e6 / result.distance_m for k, v in result.energy_kwh.items()}
-        points.append(SpeedPoint(speed_kmh, per_km))
+        points.append(SpeedPoint(speed_kmh=speed_kmh, energy_wh_per_km=per_km))
     best = min(points, key=lambda p: p.energy_wh_per_km["total"])
     return SpeedSweep(points, best.speed_kmh)
 
@@ -130,16 +132,19 @@ class Season(Params):
     weather: Weather | None = Field(None, description="Forecast; absent: the climatology.")
 
 
-@dataclass(frozen=True)
-class ScenarioCell:
-    """One cell of the grid and its energy against the baseline."""
+class ScenarioCell(Result):
+    """One cell of the grid."""
 
-    season: str
-    driver_aggressiveness: float
-    traffic_density: float | None
-    energy_kwh: dict[str, float]
-    change_vs_baseline_pct: float
-    feasible: bool
+    season: str = Field(..., description="The season's name.")
+    driver_aggressiveness: float = Field(..., description="ε_d of the cell [–].")
+    traffic_density: float | None = Field(
+        ..., description="ε_t of the cell [–]; null: each street type's default."
+    )
+    energy_kwh: dict[str, float] = Field(
+        ..., description="Energy of each consumer in this cell [kWh]."
+    )
+    change_vs_baseline_pct: float = Field(..., description="Total energy against the baseline.")
+    feasible: bool = Field(..., description="The battery holds out with its reserve.")
 
 
 @dataclass(frozen=True)

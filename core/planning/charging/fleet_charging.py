@@ -42,8 +42,8 @@ from core.planning.day.estimates import cost_matrix, energy_matrix_j
 from core.planning.day.recharge import Busy
 from core.planning.day.scene import charge_points
 from core.planning.day.start_state import start_payload_kg
-from core.planning.day.timeline import ChargeVisit
 from core.planning.day.verify import Failure, route_failure
+from core.planning.itinerary import ChargeVisit, Itinerary
 from core.planning.model import DEPOT_CHARGER_ID, PlanResult
 from core.planning.search.day import FleetDay, long_where_no_road
 from core.planning.search.repair import Repaired, repair
@@ -380,8 +380,8 @@ def _verified(
             if 0 < q < len(order) - 1 and visit.place in charging.instance.stations
         }
         reloads = [q for q, visit in enumerate(route.visits) if visit.place in charging.reloads]
-        order, charges = _charged_while_reloading(order, charges, reloads)
-        repaired, first = _held(day, v, order, charges, bookings)
+        itinerary = Itinerary.of(order, charges).reloading_while_charging(reloads)
+        repaired, first = _held(day, v, itinerary, bookings)
         if first is not None and first.battery.margin_kwh < 0:
             below_j = -first.battery.margin_kwh * JOULES_PER_KWH
             short[route.kind] = max(short.get(route.kind, 0.0), below_j)
@@ -393,23 +393,6 @@ def _verified(
     return Charging(routes, results, removed, solution.ended), short
 
 
-def _charged_while_reloading(
-    order: list[int], charges: dict[int, ChargeVisit], reloads: list[int]
-) -> tuple[list[int], dict[int, ChargeVisit]]:
-    """``order`` with a return to reload (at positions ``reloads``) beside a charge at the
-    depot made one stop: the charge, the van reloaded meanwhile (the search sees them one
-    after the other)."""
-    dropped = set()
-    for q in reloads:
-        beside = next((p for p in (q - 1, q + 1) if p in charges and order[p] == 0), None)
-        if beside is not None:
-            charges[beside] = replace(charges[beside], reloads=True)
-            dropped.add(q)
-    kept = [q for q in range(len(order)) if q not in dropped]
-    renumbered = {n: charges[q] for n, q in enumerate(kept) if q in charges}
-    return [order[q] for q in kept], renumbered
-
-
 def _visit(point: ChargePoint, charge_j: float, instance: EvrpInstance, q: int) -> ChargeVisit:
     return ChargeVisit(
         instance.service[q], charge_j * float(instance.charge_time[q]), point.power_kw
@@ -417,30 +400,18 @@ def _visit(point: ChargePoint, charge_j: float, instance: EvrpInstance, q: int) 
 
 
 def _held(
-    day: FleetDay,
-    v: int,
-    order: list[int],
-    charges: dict[int, ChargeVisit],
-    bookings: Bookings,
+    day: FleetDay, v: int, itinerary: Itinerary, bookings: Bookings
 ) -> tuple[Repaired, PlanResult | None]:
-    """Van ``v`` driving ``order`` (its chargers among the stops) with ``charges`` fitted —
-    else its stops with the charges the planner places itself
-    (:func:`core.planning.day.recharge.with_charges`) —, stops taken out until its simulation
-    holds (the chargers stay where they are); and its first simulation when neither held."""
+    """Van ``v`` driving ``itinerary`` with its charges fitted — else its stops with the
+    charges the planner places itself (:func:`core.planning.day.recharge.with_charges`) —,
+    stops taken out until its simulation holds (the chargers stay where they are); and its
+    first simulation when neither held."""
     shift = day.shifts[v]
     busy = bookings.busy(shift.id)
-    stops = [  # a charge at the depot while the van reloads is its return to reload too
-        place
-        for q, place in enumerate(order)
-        if 0 < q < len(order) - 1 and (q not in charges or charges[q].reloads)
-    ]
+    stops = itinerary.served()  # a charge at the depot while the van reloads reloads too
 
     def simulate(kept: list[int]) -> PlanResult:
-        keep = set(kept)
-        ends = (0, len(order) - 1)
-        positions = [q for q in range(len(order)) if q in charges or q in ends or order[q] in keep]
-        renumbered = {n: charges[q] for n, q in enumerate(positions) if q in charges}
-        return day.charged(v, [order[q] for q in positions], renumbered, busy)
+        return day.charged(v, itinerary.keeping(set(kept)), busy)
 
     def check(_kept: list[int], result: PlanResult) -> Failure | None:
         return route_failure(shift.id, shift.problem, day.scene.places, result, shift.end, True)
@@ -451,7 +422,7 @@ def _held(
         return Repaired(stops, result, {}), None
     # the planner's own charges (a charge point the others take, a stretch the estimates
     # made too long), before any stop goes
-    own = day.charged(v, day.order(v, stops), {}, busy)
+    own = day.charged(v, Itinerary.of(day.order(v, stops)), busy)
     if check(stops, own) is None:
         return Repaired(stops, own, {}), None
     return repair(stops, failure, simulate, check, day.estimates[v]), result

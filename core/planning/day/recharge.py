@@ -35,12 +35,13 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Protocol
 
-from core.params import ChargePoint, Charger, Place
+from core.params import ChargePoint, Charger
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, ChargeCurve, charge_curve
 from core.planning.day.scene import Scene, charge_points
-from core.planning.day.timeline import ChargeVisit, Windows, next_window, seconds_after
+from core.planning.day.timeline import next_window, seconds_after
 from core.planning.day.verify import simulate_route
+from core.planning.itinerary import ChargeVisit, Itinerary, Windows
 from core.planning.model import PlanProblem, PlanResult, Solved
 from core.routing.roads import LegRoute
 
@@ -77,7 +78,7 @@ class Orders(Protocol):
 def with_charges(
     problem: PlanProblem,
     scene: Scene,
-    order: list[int],
+    itinerary: Itinerary,
     start: dt.datetime,
     roads: Roads,
     solved: Solved,
@@ -85,9 +86,8 @@ def with_charges(
     orders: Orders | None = None,
     latest_return_s: float | None = None,
     busy: Busy | None = None,
-    charges: Mapping[int, ChargeVisit] | None = None,
 ) -> PlanResult:
-    """The round in ``order`` simulated, with charges between stops where the battery would
+    """The ``itinerary`` simulated, with charges between stops where the battery would
     not last (none when it does, or without chargers). With ``orders``, the round is then
     solved again through the chargers it visits, and each stretch between charges put in its
     own best order: the best of these that holds is kept (:func:`_better_orders`).
@@ -95,27 +95,27 @@ def with_charges(
     With ``windows_s`` (each place's time windows [s after ``start``]) and
     ``latest_return_s`` (when the van must be back), a charge is only made where the time it
     adds leaves every later window and the return in time (the forward time slack); ``busy``
-    says when other vans take every point of a charger: the van charges between. ``charges``
-    (by position in ``order``) are visits to start from, fitted again: a plan that changed a
-    little keeps its charges where they still serve (:func:`visits_of`)."""
+    says when other vans take every point of a charger: the van charges between. The
+    itinerary's charges are visits to start from, fitted again: a plan that changed a little
+    keeps its charges where they still serve (:attr:`PlanResult.itinerary`)."""
     day = _Round(problem, scene, start, roads, solved, windows_s, latest_return_s, busy or {})
     points = charge_points(problem, scene.places)
-    if charges:  # the visits of an earlier plan, fitted again (open when free now)
+    if itinerary.charges:  # the visits of an earlier plan, fitted again (open when free now)
+        order = itinerary.order
         first = {
-            q: replace(c, open_s=day.open_s(order[q], points[order[q]])) for q, c in charges.items()
+            q: replace(c, open_s=day.open_s(order[q], points[order[q]]))
+            for q, c in itinerary.charges.items()
         }
-        charged = _refitted(day, order, first)
+        charged = _refitted(day, Itinerary(order, first))
     else:
-        charged = _Charged(order, {}, day.simulate(order))
+        charged = _Charged(itinerary, day.simulate(itinerary))
     if not points or charged.result.battery.feasible:
         return charged.result
     charged = _charged_until_it_holds(day, points, charged)
     result = charged.result
-    reloads = any(  # the tour again would lose the returns to reload
-        place == 0 and (q not in charged.charges or charged.charges[q].reloads)
-        for q, place in enumerate(charged.order[1:-1], 1)
-    )
-    if orders is not None and charged.charges and result.battery.feasible and not reloads:
+    planned = charged.itinerary
+    reloads = any(planned.reloads_at(q) for q in range(len(planned.order)))
+    if orders is not None and planned.charges and result.battery.feasible and not reloads:
         result = _better_orders(day, points, charged, orders)
     if not result.battery.feasible:
         leg = result.first_infeasible_leg
@@ -149,39 +149,34 @@ def _too_slow(day: _Round, points: dict[int, ChargePoint]) -> list[str]:
 
 
 def _charged(
-    day: _Round,
-    points: dict[int, ChargePoint],
-    order: list[int],
-    charges: dict[int, ChargeVisit],
-    result: PlanResult,
-    stretch: tuple[int, int],
-) -> tuple[list[int], dict[int, ChargeVisit], PlanResult] | None:
+    day: _Round, points: dict[int, ChargePoint], charged: _Charged, stretch: tuple[int, int]
+) -> _Charged | None:
     """The day with one more charge in ``stretch``: the best of the options
     (:func:`_charge_options`, at most :data:`OPTIONS_TRIED` simulated) that the simulation
     says the van reaches with its reserve and that leaves the day's lowest point higher;
     None when none does."""
     reserve = day.problem.van.battery.min_soc
-    for option in _charge_options(day, points, order, charges, result, stretch)[:OPTIONS_TRIED]:
+    itinerary, result = charged.itinerary, charged.result
+    for option in _charge_options(day, points, charged, stretch)[:OPTIONS_TRIED]:
         cut = option.cut
-        if option.inserted:
-            tried = [*order[: cut + 1], option.place, *order[cut + 1 :]]
-            visits = {q + (q > cut): c for q, c in charges.items()} | {cut + 1: option.visit}
-        else:  # at the depot, where the van reloads
-            tried, visits = order, charges | {cut: option.visit}
-        charged = _refitted(day, tried, visits)  # filled, then every charge fitted
-        simulated = charged.result
+        tried = (
+            itinerary.with_charge(cut, option.place, option.visit)
+            if option.inserted
+            else itinerary.charged_at(cut, option.visit)  # at the depot, where the van reloads
+        )
+        again = _refitted(day, tried)  # filled, then every charge fitted
+        simulated = again.result
         reached = simulated.legs[cut if option.inserted else cut - 1].soc_end >= reserve
         if reached and simulated.battery.margin_kwh > result.battery.margin_kwh:
-            return charged.order, charged.charges, simulated
+            return again
     return None
 
 
 @dataclass(frozen=True)
 class _Charged:
-    """A round's order, its charges by position and its simulation."""
+    """A round's itinerary and its simulation."""
 
-    order: list[int]
-    charges: dict[int, ChargeVisit]
+    itinerary: Itinerary
     result: PlanResult
 
 
@@ -190,15 +185,14 @@ def _charged_until_it_holds(
 ) -> _Charged:
     """``charged`` with one more charge in its first stretch below the reserve, again and
     again, until the battery holds or no charger is within reach."""
-    for _ in range(len(charged.order)):
-        order, charges, result = charged.order, charged.charges, charged.result
-        stretch = _first_short_stretch(day.problem, order, charges, result)
+    for _ in range(len(charged.itinerary.order)):
+        stretch = _first_short_stretch(day.problem, charged)
         if stretch is None:
             break
-        tried = _charged(day, points, order, charges, result, stretch)
+        tried = _charged(day, points, charged, stretch)
         if tried is None:
             break  # no charger within reach
-        charged = _Charged(*tried)
+        charged = tried
     return charged
 
 
@@ -215,19 +209,16 @@ class _Round:
     latest_return_s: float | None = None
     busy: Busy = field(default_factory=dict)
 
-    def simulate(
-        self, order: list[int], charges: dict[int, ChargeVisit] | None = None
-    ) -> PlanResult:
+    def simulate(self, itinerary: Itinerary) -> PlanResult:
         return simulate_route(
             self.problem,
             self.scene,
-            order,
+            itinerary,
             self.start,
-            self.roads(order),
+            self.roads(list(itinerary.order)),
             self.solved,
             self.windows_s,
             self.latest_return_s,
-            charges,
         )
 
     def curve(self, point: ChargePoint, result: PlanResult) -> ChargeCurve:
@@ -270,31 +261,6 @@ def _without(windows: Windows, taken: Windows) -> list[tuple[float, float]]:
     return free
 
 
-def visits_of(
-    problem: PlanProblem, places: list[Place], result: PlanResult, start: int = 0
-) -> tuple[list[int], dict[int, ChargeVisit]]:
-    """The order (place indices) a plan drove from place ``start`` (the depot, or the van's
-    position) and its charges by position, as visits to start a changed plan from."""
-    index = {place.id: k for k, place in enumerate(places)}
-    order = [start, *(index[i] for i in result.tour[1:-1]), 0]
-    points = charge_points(problem, places)
-    by_arrival = {charge.arrive: charge for charge in result.charges}
-    reloaded = {reload.arrive for reload in result.reloads}
-    visits = {}
-    for q in range(1, len(order) - 1):
-        came = result.legs[q - 1].arrive
-        charge = by_arrival.get(came)
-        if order[q] in points and charge is not None:
-            point = points[order[q]]
-            visits[q] = ChargeVisit(
-                point.plug_minutes * 60,
-                charge.minutes * 60,
-                point.power_kw,
-                reloads=order[q] == 0 and came in reloaded,
-            )
-    return order, visits
-
-
 def _better_orders(
     day: _Round, points: dict[int, ChargePoint], charged: _Charged, orders: Orders
 ) -> PlanResult:
@@ -303,7 +269,7 @@ def _better_orders(
     the chargers it visits (the solver then passes them where it costs least; charged more
     where it still runs short), and every stretch between charges in its own best order (of
     either)."""
-    order, charges = charged.order, charged.charges
+    order, charges = charged.itinerary.order, charged.itinerary.charges
     chargers = [order[q] for q in sorted(charges)]
     through = orders.through(chargers)
     visits = {
@@ -313,17 +279,18 @@ def _better_orders(
     for q in range(1, len(through) - 1):
         if visits.get(through[q]):
             again[q] = visits[through[q]].pop(0)
-    retoured = _charged_until_it_holds(day, points, _refitted(day, through, again))
+    retoured = _charged_until_it_holds(day, points, _refitted(day, Itinerary.of(through, again)))
     best = charged.result
     for candidate in (charged, retoured):
-        ends = _stretch_ends(candidate.order, candidate.charges)
+        planned = candidate.itinerary
         stretches = [
-            orders.stretch(candidate.order[a : b + 1]) for a, b in itertools.pairwise(ends)
+            orders.stretch(list(planned.order[a : b + 1]))
+            for a, b in itertools.pairwise(planned.stretch_ends())
         ]
-        reordered = [candidate.order[0], *(place for stretch in stretches for place in stretch[1:])]
+        reordered = (planned.order[0], *(place for stretch in stretches for place in stretch[1:]))
         tried = [candidate]
-        if reordered != candidate.order:
-            tried.append(_refitted(day, reordered, candidate.charges))
+        if reordered != planned.order:
+            tried.append(_refitted(day, Itinerary(reordered, planned.charges)))
         for option in tried:
             result = option.result
             if result.battery.feasible and _measure(result) < _measure(best):
@@ -331,18 +298,18 @@ def _better_orders(
     return best
 
 
-def _refitted(day: _Round, order: list[int], charges: dict[int, ChargeVisit]) -> _Charged:
-    """The day in ``order`` with ``charges`` (by position) fitted to what it takes. A visit
-    left with nothing to charge is dropped, and the others fitted again: its detour is no
-    longer driven, so the stretch it closed takes less."""
-    result = day.simulate(order, charges)
-    for _ in range(len(charges) + 1):
-        fitted = _fitted(day.problem, order, result, charges)
-        order, charges = _without_idle(order, fitted)
-        result = day.simulate(order, charges)
-        if len(charges) == len(fitted):
+def _refitted(day: _Round, itinerary: Itinerary) -> _Charged:
+    """The day of ``itinerary`` with its charges fitted to what it takes. A visit left with
+    nothing to charge is dropped, and the others fitted again: its detour is no longer driven,
+    so the stretch it closed takes less."""
+    result = day.simulate(itinerary)
+    for _ in range(len(itinerary.charges) + 1):
+        fitted = _fitted(day.problem, itinerary, result)
+        itinerary = itinerary.refitted(fitted)
+        result = day.simulate(itinerary)
+        if len(itinerary.charges) == len(fitted):
             break
-    return _Charged(order, charges, result)
+    return _Charged(itinerary, result)
 
 
 def _measure(result: PlanResult) -> float:
@@ -354,25 +321,17 @@ def _measure(result: PlanResult) -> float:
     return result.distance_m
 
 
-def _stretch_ends(order: list[int], charges: dict[int, ChargeVisit]) -> list[int]:
-    """Where the stretches of ``order`` begin and end: its start (the depot, or the van's
-    position when it starts under way), each charge, its end."""
-    return [0, *sorted(charges), len(order) - 1]
-
-
 def _stretch_low(result: PlanResult, first: int, last: int) -> float:
     """The lowest state of charge over legs ``first`` to ``last − 1`` (a stretch) [–]."""
     legs = result.legs[first:last]
     return min(min(leg.soc_start, leg.soc_end) for leg in legs)
 
 
-def _first_short_stretch(
-    problem: PlanProblem, order: list[int], charges: dict[int, ChargeVisit], result: PlanResult
-) -> tuple[int, int] | None:
+def _first_short_stretch(problem: PlanProblem, charged: _Charged) -> tuple[int, int] | None:
     """The first stretch (from one charge, or the start, to the next) below the reserve."""
     reserve = problem.van.battery.min_soc
-    for first, last in itertools.pairwise(_stretch_ends(order, charges)):
-        if _stretch_low(result, first, last) < reserve - 1e-9:
+    for first, last in itertools.pairwise(charged.itinerary.stretch_ends()):
+        if _stretch_low(charged.result, first, last) < reserve - 1e-9:
             return first, last
     return None
 
@@ -391,12 +350,7 @@ class _Option:
 
 
 def _charge_options(
-    day: _Round,
-    points: dict[int, ChargePoint],
-    order: list[int],
-    charges: dict[int, ChargeVisit],
-    result: PlanResult,
-    stretch: tuple[int, int],
+    day: _Round, points: dict[int, ChargePoint], charged: _Charged, stretch: tuple[int, int]
 ) -> list[_Option]:
     """Where the van may charge within ``stretch``, best first: after each stop it leaves
     with its reserve, each charger it reaches with its reserve and that is open long enough
@@ -405,6 +359,7 @@ def _charge_options(
     cover the rest of the stretch, the rest at another visit like it)."""
     reserve = day.problem.van.battery.min_soc
     legs = day.scene.legs
+    order, charges, result = charged.itinerary.order, charged.itinerary.charges, charged.result
     capacity_j = result.battery.usable_capacity_kwh * JOULES_PER_KWH
     driven_j = sum(leg.energy_kwh["traction"] for leg in result.legs) * JOULES_PER_KWH
     per_metre_j = max(driven_j, 0.0) / max(result.distance_m, 1.0) * RETURN_ENERGY_FACTOR
@@ -492,7 +447,7 @@ def _reload_charge(
     return _Option(p, 0, added_s, visit, inserted=False)
 
 
-def _slack_s(day: _Round, order: list[int], result: PlanResult) -> list[float]:
+def _slack_s(day: _Round, order: Sequence[int], result: PlanResult) -> list[float]:
     """How much later the van may reach each position of ``order`` and still serve every
     later stop inside its window and be back in time [s] (Savelsbergh's forward time slack,
     *ORSA J. Computing* 4 (1992) 146: a delay is absorbed by the waits, then shifts each
@@ -531,13 +486,13 @@ def _energy_j(result: PlanResult, first: int, end: int) -> float:
 
 
 def _fitted(
-    problem: PlanProblem, order: list[int], result: PlanResult, charges: dict[int, ChargeVisit]
+    problem: PlanProblem, itinerary: Itinerary, result: PlanResult
 ) -> dict[int, ChargeVisit]:
     """Every charge fitted to the stretch after it, from what ``result`` simulated: the state
     of charge each stretch drops by does not depend on where it starts."""
     battery = problem.van.battery
     share = result.battery.usable_capacity_kwh / battery.usable_capacity_kwh
-    ends = _stretch_ends(order, charges)
+    ends = itinerary.stretch_ends()
     plugged = {charge.arrive: charge.soc_before for charge in result.charges}
     fitted: dict[int, ChargeVisit] = {}
     leaving = result.legs[0].soc_start
@@ -553,20 +508,8 @@ def _fitted(
             if battery.charge_to_full
             else min(battery.min_soc + drop + PARTIAL_CHARGE_MARGIN, 1.0)
         )
-        visit = charges[here]
+        visit = itinerary.charges[here]
         curve = charge_curve(battery, visit.power_kw * WATTS_PER_KW, share)
         fitted[here] = replace(visit, charge_s=min(curve.time_s(arriving, target), MAX_CHARGE_S))
         leaving = max(arriving, target)
     return fitted
-
-
-def _without_idle(
-    order: list[int], charges: dict[int, ChargeVisit]
-) -> tuple[list[int], dict[int, ChargeVisit]]:
-    """``order`` and ``charges`` without the charger visits that have nothing to charge (an
-    earlier charge covers their stretch too); a return to reload stays, without its charge."""
-    idle = {q for q, visit in charges.items() if visit.charge_s <= 0}
-    gone = {q for q in idle if not charges[q].reloads}
-    kept = [place for q, place in enumerate(order) if q not in gone]
-    moved = {q - sum(i < q for i in gone): visit for q, visit in charges.items() if q not in idle}
-    return kept, moved

@@ -12,7 +12,7 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -40,14 +40,13 @@ from core.physics.cycles import (
 from core.physics.motor import power_limited
 from core.physics.simulate import MAX_SPEED_MPS
 from core.planning.day.start_state import start_payload_kg
+from core.planning.itinerary import ChargeVisit, Itinerary, Windows
 from core.planning.model import PlanProblem
 from core.routing.geo import STREET_TYPE_NAMES, Legs, street_type_by_speed
 from core.routing.roads import LegRoute, bearing_deg
 
 #: Sampling interval of the day's simulation [s].
 PLAN_DT_S = 1.0
-#: A place's time windows: ``(opens, closes)`` in seconds after a reference, sorted.
-Windows = Sequence[tuple[float, float]]
 
 
 def next_window(arrival_s: float, windows_s: Windows) -> tuple[float, float] | None:
@@ -135,21 +134,6 @@ class Break:
     start_s: float
     end_s: float
     kind: str
-
-
-@dataclass(frozen=True)
-class ChargeVisit:
-    """A stop at a charger between stops (the depot's or one on the way): the minutes to plug
-    in and out and the charge itself [s], at a point of ``power_kw``, open during ``open_s``
-    (seconds after the departure; empty: always). The van waits for the opening; the charge
-    ends at the closing at the latest. ``reloads``: at the depot, where the van comes back to
-    reload as well (it stands the longer of the two)."""
-
-    plug_s: float
-    charge_s: float
-    power_kw: float
-    open_s: Windows = ()
-    reloads: bool = False
 
 
 @dataclass(frozen=True)
@@ -501,22 +485,21 @@ def build_timeline(
     problem: PlanProblem,
     places: list[Place],
     legs: Legs,
-    order: list[int],
+    itinerary: Itinerary,
     routes: list[LegRoute] | None,
     windows_s: Sequence[Windows] | None = None,
-    charges: Mapping[int, ChargeVisit] | None = None,
     rest: Rest | None = None,
 ) -> Timeline:
     """Speed, grade, payload and heading of every sample of the day, the door openings, the
-    stops and the marks, for the places in ``order`` (depot first and last; the van charges
-    at the depot or a charger between stops as ``charges`` says, by position in ``order``). With
-    ``windows_s`` (each place's time windows, seconds after the departure) the van waits,
-    parked with the door shut, for a stop's window to open; a stop reached after its last
-    window closes is served at once and listed in ``late``. ``rest``: the driver's breaks,
-    taken between stops (:meth:`_Builder.rest_before`)."""
+    stops and the marks, for the ``itinerary`` (its stops served, its charges made, its returns
+    to the depot reloaded). With ``windows_s`` (each place's time windows, seconds after the
+    departure) the van waits, parked with the door shut, for a stop's window to open; a stop
+    reached after its last window closes is served at once and listed in ``late``. ``rest``:
+    the driver's breaks, taken between stops (:meth:`_Builder.rest_before`)."""
     rest = rest or Rest()
     day = _Builder(start_payload_kg(problem), rest=rest, driving_s=rest.driven_s)
-    for k, (i, j) in enumerate(itertools.pairwise(order)):
+    reload = (problem.reload_minutes * 60, problem.van.payload_kg)
+    for k, (i, j) in enumerate(itertools.pairwise(itinerary.order)):
         a, b = places[i], places[j]
         route = routes[k] if routes is not None else None
         leg = drive(
@@ -531,16 +514,14 @@ def build_timeline(
             else [(a.lon, a.lat), (b.lon, b.lat)]
         )
         day.drive(leg.speed_mps, leg.heading_deg, float(legs.grade[i, j]))
-        if 0 < j <= len(problem.stops):
+        kind = itinerary.kind(k + 1, len(problem.stops))
+        if kind == "stop":
             day.serve(j, problem.stops[j - 1], windows_s[j] if windows_s is not None else ())
-        elif charges is not None and k + 1 in charges:
-            visit = charges[k + 1]  # reloaded while it charges, when it came back for both
-            reload = (
-                (problem.reload_minutes * 60, problem.van.payload_kg) if visit.reloads else None
-            )
-            day.charge(k + 1, visit, reload)
-        elif j == 0 and k + 2 < len(order):  # back at the depot between stops, not to charge
-            day.reload(k + 1, problem.reload_minutes * 60, problem.van.payload_kg)
+        elif kind == "charge":  # reloaded while it charges, when it came back for both
+            visit = itinerary.charges[k + 1]
+            day.charge(k + 1, visit, reload if itinerary.reloads_at(k + 1) else None)
+        elif kind == "reload":
+            day.reload(k + 1, *reload)
         else:
             day.marks["serve"].append(day.clock)
         day.marks["leave"].append(day.clock)
@@ -549,7 +530,7 @@ def build_timeline(
 
 def later_departure_s(
     timeline: Timeline,
-    order: list[int],
+    order: Sequence[int],
     windows_s: Sequence[Windows],
     latest_return_s: float | None,
 ) -> float:

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,13 +23,12 @@ from core.planning.day.scene import Scene, charge_points
 from core.planning.day.start_state import box_start_c, start_payload_kg
 from core.planning.day.timeline import (
     PLAN_DT_S,
-    ChargeVisit,
     Timeline,
-    Windows,
     build_timeline,
     later_departure_s,
     rest_after,
 )
+from core.planning.itinerary import Itinerary, Windows
 from core.planning.model import (
     DEPOT_CHARGER_ID,
     BreakResult,
@@ -52,15 +51,14 @@ PROFILE_STEP_S = 60.0
 def simulate_route(
     problem: PlanProblem,
     scene: Scene,
-    order: list[int],
+    itinerary: Itinerary,
     start: dt.datetime,
     roads: list[LegRoute] | None,
     solved: Solved,
     windows_s: Sequence[Windows] | None = None,
     latest_return_s: float | None = None,
-    charges: Mapping[int, ChargeVisit] | None = None,
 ) -> PlanResult:
-    """Drive the places in ``order`` (depot first and last) from ``start`` and simulate the day.
+    """Drive the ``itinerary`` from ``start`` and simulate the day.
 
     Parameters
     ----------
@@ -68,8 +66,8 @@ def simulate_route(
         The van, the stops and the conditions.
     scene
         The places, their legs, the zone and the weather.
-    order
-        Place indices in driving order, 0 first and last.
+    itinerary
+        The places in driving order and the charges between them.
     start
         Departure (zone-aware).
     roads
@@ -83,25 +81,19 @@ def simulate_route(
         and listed in ``late_stops``.
     latest_return_s
         When the van must be back [s after ``start``], if ever.
-    charges
-        The charges between stops (at the depot or a charger), by position in ``order``.
     """
 
     def laid_out(departure: dt.datetime, windows: Sequence[Windows] | None) -> Timeline:
         places, legs, rest = scene.places, scene.legs, rest_after(problem, departure)
-        return build_timeline(problem, places, legs, order, roads, windows, charges, rest)
+        return build_timeline(problem, places, legs, itinerary, roads, windows, rest)
 
     timeline = laid_out(start, windows_s)
     if windows_s is not None and problem.start_state is None:  # under way: it drives on now
-        delay_s = later_departure_s(timeline, order, windows_s, latest_return_s)
+        delay_s = later_departure_s(timeline, itinerary.order, windows_s, latest_return_s)
         if delay_s > 0:  # every span after the departure comes as much nearer
             start = at(start, delay_s)
             windows_s = [[(a - delay_s, b - delay_s) for a, b in place] for place in windows_s]
-            if charges:
-                charges = {
-                    q: replace(c, open_s=[(a - delay_s, b - delay_s) for a, b in c.open_s])
-                    for q, c in charges.items()
-                }
+            itinerary = itinerary.shifted(delay_s)
             timeline = laid_out(start, windows_s)
     check_representable(start, timeline.duration_s, "date")
     weather, warnings = scene.weather_for(start, timeline.duration_s)
@@ -122,7 +114,7 @@ def simulate_route(
         box_start_c=box_start_c(problem),
     )
     timeline = timeline.driven(result.sample_at)
-    return _Split(problem, scene, order, result, timeline, start).result(solved, warnings)
+    return _Split(problem, scene, itinerary, result, timeline, start).result(solved, warnings)
 
 
 def _long_day(problem: PlanProblem, start: dt.datetime, timeline: Timeline) -> list[str]:
@@ -152,12 +144,13 @@ class _Split:
         self,
         problem: PlanProblem,
         scene: Scene,
-        order: list[int],
+        itinerary: Itinerary,
         result: SimulationResult,
         timeline: Timeline,
         start: dt.datetime,
     ) -> None:
-        self.problem, self.scene, self.order = problem, scene, order
+        self.problem, self.scene, self.itinerary = problem, scene, itinerary
+        self.order = itinerary.order
         self.simulated, self.timeline, self.start = result, timeline, start
         self.cumulative_j = {
             name: np.concatenate(([0.0], np.cumsum(power) * PLAN_DT_S))
@@ -207,7 +200,7 @@ class _Split:
         for k, j in enumerate(self.order[1:-1]):
             if k + 1 in reloads:
                 payload = self.problem.van.payload_kg
-            if not 0 < j <= len(self.problem.stops):  # at a charger or reloading
+            if self.itinerary.kind(k + 1, len(self.problem.stops)) != "stop":
                 continue
             b, c = int(self.timeline.arrive[k]), int(self.timeline.leave[k])
             served = int(self.timeline.serve[k])
@@ -262,9 +255,9 @@ class _Split:
         """The returns to the depot to reload."""
         return [
             ReloadResult(
-                self.moment(int(self.timeline.arrive[q - 1])),
-                self.moment(int(self.timeline.leave[q - 1])),
-                self.problem.van.payload_kg,
+                arrive=self.moment(int(self.timeline.arrive[q - 1])),
+                depart=self.moment(int(self.timeline.leave[q - 1])),
+                payload_kg=self.problem.van.payload_kg,
             )
             for q in self.timeline.reloaded_at
         ]
@@ -280,8 +273,8 @@ class _Split:
             # the box's temperature is at the end of each step: sample i ends step i - 1
             box = self.simulated.box.temperature_c[np.maximum(picks - 1, 0)].tolist()
         return DayProfile(
-            [self.moment(int(i)) for i in picks],
-            kwh,
+            time=[self.moment(int(i)) for i in picks],
+            energy_kwh=kwh,
             soc=self.simulated.soc[picks].tolist(),
             box_temperature_c=box,
         )
@@ -325,10 +318,15 @@ class _Split:
             objective=self.problem.objective,
             profile=self.profile(),
             late_stops=[places[j].id for j in self.timeline.late],
+            itinerary=self.itinerary,
             charges=self.charges(),
             reloads=self.reloads(),
             breaks=[
-                BreakResult(self.moment(round(b.start_s)), self.moment(round(b.end_s)), b.kind)
+                BreakResult(
+                    start=self.moment(round(b.start_s)),
+                    end=self.moment(round(b.end_s)),
+                    kind=b.kind,
+                )
                 for b in self.timeline.breaks
             ],
         )

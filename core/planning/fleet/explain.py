@@ -35,15 +35,20 @@ def explain(
     stop_id = day.scene.places[node].id
     if node in day.unreachable:
         depot = day.scene.places[0].id
-        return Unassigned(stop_id, "unreachable", f"no road links it with the depot '{depot}'")
+        return Unassigned(
+            id=stop_id, reason="unreachable", detail=f"no road links it with the depot '{depot}'"
+        )
     alone = [rules.alone(v, node) for v in day.vans]
     if all(why is not None for why in alone):
         refusals = [why for why in alone if why is not None]
         reason = _most_shared(Counter(why.reason for why in refusals))
-        return Unassigned(stop_id, reason, next(w.detail for w in refusals if w.reason == reason))
+        detail = next(w.detail for w in refusals if w.reason == reason)
+        return Unassigned(id=stop_id, reason=reason, detail=detail)
     if failure is not None:
-        return Unassigned(stop_id, failure.reason, f"left out after simulation: {failure.detail}")
-    return Unassigned(stop_id, *_full(rules, node, routes))
+        detail = f"left out after simulation: {failure.detail}"
+        return Unassigned(id=stop_id, reason=failure.reason, detail=detail)
+    reason, detail = _full(rules, node, routes)
+    return Unassigned(id=stop_id, reason=reason, detail=detail)
 
 
 def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[UnassignedReason, str]:

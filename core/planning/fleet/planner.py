@@ -294,8 +294,8 @@ class Routed:
                 r,
                 plan=replace(
                     r.plan,
-                    solved=replace(
-                        r.plan.solved, runtime_s=runtime_s, stopped_by=self.ended, proven=()
+                    solved=r.plan.solved.model_copy(
+                        update={"runtime_s": runtime_s, "stopped_by": self.ended, "proven": ()}
                     ),
                 ),
             )
@@ -608,7 +608,7 @@ def _charged(
         routes,
         results,
         [
-            replace(u, detail=f"{u.detail}; {said}") if u.reason == "battery" else u
+            u.model_copy(update={"detail": f"{u.detail}; {said}"}) if u.reason == "battery" else u
             for u in unassigned
         ],
     )

@@ -26,7 +26,7 @@ from core.exceptions import (
 from core.params import Place
 from core.physics.weather import WeatherService
 from core.planning.day.estimates import cost_matrix
-from core.planning.day.recharge import visits_of, with_charges
+from core.planning.day.recharge import with_charges
 from core.planning.day.scene import (
     Scene,
     charge_points,
@@ -38,6 +38,7 @@ from core.planning.day.scene import (
 from core.planning.day.start_state import START_ID, check_start, path_tour, under_way
 from core.planning.day.timeline import client_legs_too_fast, windows_after
 from core.planning.fleet.planner import search
+from core.planning.itinerary import Itinerary
 from core.planning.model import (
     MAX_ROUND_S,
     PlanProblem,
@@ -123,10 +124,14 @@ def plan(
     result = with_charges(
         problem,
         scene,
-        order,
+        Itinerary.of(order),
         start,
         roads,
-        Solved(tour.status, tour.cost * unit_value + offset * (len(order) - 1), tour.runtime_s),
+        Solved(
+            status=tour.status,
+            objective_value=tour.cost * unit_value + offset * (len(order) - 1),
+            runtime_s=tour.runtime_s,
+        ),
         windows_after(problem.stops, problem.date, start) if windowed else None,
         None if problem.keep_order else tours,
     )
@@ -164,11 +169,12 @@ def _how_solved(
     ]
     whole = kept and not (result.charges or result.reloads)
     status = tour.status if tour.status != "optimal" else ("optimal" if whole else "feasible")
-    return replace(
-        result.solved,
-        status=status,
-        stopped_by=combined(ends),
-        proven=("order",) if kept else (),
+    return result.solved.model_copy(
+        update={
+            "status": status,
+            "stopped_by": combined(ends),
+            "proven": ("order",) if kept else (),
+        }
     )
 
 
@@ -249,12 +255,12 @@ def _in_windows(
         )
     result = routed.routes[0].plan
     if not result.battery.feasible and charge_points(problem, scene.places):
-        order, _ = visits_of(problem, scene.places, result, day.starts[0])
-        charged = day.charged(0, order, {}, {})
+        # its charges placed afresh
+        charged = day.charged(0, Itinerary.of(result.itinerary.order), {})
         if charged.battery.margin_kwh > result.battery.margin_kwh:
             result = replace(charged, solved=result.solved)
-    solved = replace(
-        result.solved, runtime_s=time.perf_counter() - started, stopped_by=routed.ended
+    solved = result.solved.model_copy(
+        update={"runtime_s": time.perf_counter() - started, "stopped_by": routed.ended}
     )
     return replace(result, solved=solved, warnings=[*result.warnings, *cut_short(routed.ended)])
 

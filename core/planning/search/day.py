@@ -22,8 +22,9 @@ from core.planning.day.estimates import VanEstimates, van_estimates
 from core.planning.day.recharge import Busy, with_charges
 from core.planning.day.scene import Scene
 from core.planning.day.start_state import start_payload_kg
-from core.planning.day.timeline import ChargeVisit, windows_after
+from core.planning.day.timeline import windows_after
 from core.planning.day.verify import simulate_route
+from core.planning.itinerary import Itinerary
 from core.planning.model import MAX_ROUND_S, PlanProblem, PlanResult, Solved, place_field
 from core.routing.geo import Legs
 from core.routing.roads import LegRoute, RoadRouter
@@ -148,39 +149,30 @@ class FleetDay:
         its shift's end."""
         problem, scene, order, start, solved = self._round(v, route)
         windows, latest_s = self._limits(v)
+        itinerary = Itinerary.of(order)
         return simulate_route(
-            problem, scene, order, start, self._roads(order), solved, windows, latest_s
+            problem, scene, itinerary, start, self._roads(order), solved, windows, latest_s
         )
 
-    def charged(
-        self, v: int, order: list[int], charges: dict[int, ChargeVisit], busy: Busy
-    ) -> PlanResult:
-        """Van ``v`` driving ``order`` (place indices, the chargers it visits among them) with
-        ``charges`` fitted again and more where its battery would not last
-        (:func:`core.planning.day.recharge.with_charges`): its windows and its shift kept, the
-        charge points free when ``busy`` says other vans do not take them all."""
-        stops = [place for place in order[1:-1] if place in self.stop_nodes]
+    def charged(self, v: int, itinerary: Itinerary, busy: Busy) -> PlanResult:
+        """Van ``v`` driving ``itinerary`` with its charges fitted again and more where its
+        battery would not last (:func:`core.planning.day.recharge.with_charges`): its windows
+        and its shift kept, the charge points free when ``busy`` says other vans do not take
+        them all."""
+        stops = [place for place in itinerary.order[1:-1] if place in self.stop_nodes]
         problem, scene, _, start, solved = self._round(v, stops)
         windows, latest_s = self._limits(v)
         return with_charges(
-            problem,
-            scene,
-            order,
-            start,
-            self._roads,
-            solved,
-            windows,
-            None,
-            latest_s,
-            busy,
-            charges,
+            problem, scene, itinerary, start, self._roads, solved, windows, None, latest_s, busy
         )
 
     def _round(
         self, v: int, route: list[int]
     ) -> tuple[PlanProblem, Scene, list[int], dt.datetime, Solved]:
         shift = self.shifts[v]
-        solved = Solved("feasible", self.estimates[v].route_cost(route), 0.0)
+        solved = Solved(
+            status="feasible", objective_value=self.estimates[v].route_cost(route), runtime_s=0.0
+        )
         return shift.problem, self.scene, self.order(v, route), shift.start, solved
 
     def _roads(self, order: list[int]) -> list[LegRoute] | None:

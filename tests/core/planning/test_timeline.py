@@ -11,6 +11,7 @@ import pytest
 
 from core.params import Stop, TimeWindow
 from core.planning.day.timeline import build_timeline, later_departure_s, next_window, windows_after
+from core.planning.itinerary import Itinerary
 from tests.utils.fleets import DEPOT, day_of, fleet, two_clusters, van
 
 
@@ -35,7 +36,9 @@ def test_the_marks_of_a_day_on_the_client_matrix():
     stops, matrix = two_clusters()
     day = day_of(fleet(stops, [van("a")], matrix=matrix))
     problem = day.shifts[0].problem
-    timeline = build_timeline(problem, [DEPOT, *stops], day.scene.legs, [0, 1, 2, 0], None)
+    timeline = build_timeline(
+        problem, [DEPOT, *stops], day.scene.legs, Itinerary.of([0, 1, 2, 0]), None
+    )
     # 10 min out, 5 min service, 2 min on, 5 min service, 10 min back (the client's times).
     assert timeline.depart.tolist() == [0, 900, 1320]
     assert timeline.arrive.tolist() == [600, 1020, 1920]
@@ -53,7 +56,9 @@ def test_the_van_leaves_later_by_what_it_would_wait():
     day = day_of(fleet(stops, [van("a")], matrix=matrix))
     problem = day.shifts[0].problem
     windows = day.windows_s  # seconds after 08:00, the van's departure
-    timeline = build_timeline(problem, [DEPOT, *stops], day.scene.legs, [0, 1, 0], None, windows)
+    timeline = build_timeline(
+        problem, [DEPOT, *stops], day.scene.legs, Itinerary.of([0, 1, 0]), None, windows
+    )
     # Arrives 08:10, waits 50 min for 09:00: leaving 50 min later costs nothing.
     assert timeline.serve.tolist()[0] - timeline.arrive.tolist()[0] == 3000
     assert later_departure_s(timeline, [0, 1, 0], windows, None) == pytest.approx(3000)
