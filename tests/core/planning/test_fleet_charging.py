@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -14,10 +15,15 @@ import pytest
 from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop
 from core.planning.charging.fleet_charging import Bookings
 from core.planning.day.timeline import MAX_DRIVING_S
+from core.planning.day.verify import Failure
 from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
 from tests.core.planning.test_breaks import driving_between_breaks_s
 from tests.core.planning.test_recharge import summer_day
+from tests.utils.fleets import DEPOT
+from tests.utils.fleets import fleet as cluster_fleet
+from tests.utils.fleets import two_clusters as clusters
+from tests.utils.fleets import van as cluster_van
 
 FAST = Charger(id="hpc-prater", lat=48.215, lon=16.40, power_kw=150, price_per_kwh=0.59)
 
@@ -130,3 +136,46 @@ def test_bookings_say_when_every_point_is_taken():
     # a van's own charges do not block it
     assert bookings.busy("a")[0] == [(at(60), at(90))]
     assert bookings.busy("b")[5] == []
+
+
+def test_a_stop_the_charging_verification_left_out_goes_to_an_idle_van(monkeypatch):
+    """The charging search's verification takes a stop out of a route (here: made to): a van
+    with no route serves it on a round of its own, as it would without charging, and the
+    fleet serves every stop rather than fall back on the routes found without charging (vans
+    of 5 kWh: a cluster of three takes 3.3 kWh, all six 7.8 kWh; the second van's shift,
+    08:00–08:30, leaves it time for one stop — without charging the two serve four)."""
+    import core.planning.fleet.planner as planner
+
+    searched = planner.charging_routes
+    dropped: list[str] = []
+
+    def dropping(day, *args, **kwargs):
+        found = searched(day, *args, **kwargs)
+        v = max((v for v, r in enumerate(found.routes) if r), key=lambda v: len(found.routes[v]))
+        node = found.routes[v][-1]
+        dropped.append(day.scene.places[node].id)
+        routes = [list(r) for r in found.routes]
+        routes[v] = routes[v][:-1]
+        kept = found.results[v].itinerary.keeping(set(routes[v]))  # its charges where they were
+        results = dict(found.results) | {v: day.charged(v, kept, {})}
+        removed = {node: Failure("battery", node, "made to fail")}
+        return replace(found, routes=routes, results=results, removed=removed)
+
+    monkeypatch.setattr(planner, "charging_routes", dropping)
+    stops, matrix = clusters()
+    depot = DEPOT.model_copy(update={"charger": ChargePoint(power_kw=22, points=2)})
+    small = BatteryParams(usable_capacity_kwh=5.0)
+    problem = cluster_fleet(
+        stops,
+        [cluster_van("van-0", battery=small), cluster_van("van-1", end="08:30", battery=small)],
+        matrix=matrix,
+        minimize_vehicles=True,
+        time_limit_s=20,
+    )
+    result = plan_fleet(problem.model_copy(update={"depot": depot}))
+    (stop,) = dropped
+    assert not result.unassigned
+    charged, alone = result.routes
+    assert [s.id for s in alone.plan.stops] == [stop] and alone.vehicle_id == "van-1"
+    assert len(charged.plan.stops) == 5 and charged.plan.charges
+    assert all(r.plan.battery.feasible for r in result.routes)
