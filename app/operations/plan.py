@@ -22,6 +22,7 @@ from app.schemas.plans import (
     SolverOut,
     StopOut,
     Totals,
+    VisitOut,
 )
 from app.settings import Settings
 from core.planning.model import DayProfile, PlanFields, PlanProblem, PlanResult, fields_of
@@ -75,6 +76,7 @@ def plan_response(
         charges=[ChargeOut(**dict(charge)) for charge in result.charges],
         reloads=[ReloadOut(**dict(reload)) for reload in result.reloads],
         breaks=[BreakOut(**dict(rest)) for rest in result.breaks],
+        visits=[VisitOut(**dict(v) | {"energy_kwh": energy(v.energy_kwh)}) for v in result.visits],
         totals=Totals(
             distance_m=result.distance_m,
             duration_s=result.duration_s,

@@ -30,6 +30,7 @@ from core.planning.model import (
     ReloadResult,
     Solved,
     StopResult,
+    VisitResult,
 )
 
 
@@ -86,6 +87,14 @@ class BreakOut(ApiModel, BreakResult):
     """A driver's break, parked (cab and refrigeration drawing)."""
 
 
+class VisitOut(ApiModel, VisitResult):
+    """One visit of the van's day, in time order."""
+
+    energy_kwh: EnergyKwh = Field(  # type: ignore[assignment]
+        ..., description="Energy of each consumer from arrival to departure [kWh]."
+    )
+
+
 class Totals(ApiModel):
     """The whole round."""
 
@@ -139,6 +148,13 @@ class PlanResponse(ApiModel):
     )
     breaks: list[BreakOut] = Field(
         default_factory=list, description="The driver's breaks, in order (between stops)."
+    )
+    visits: list[VisitOut] = Field(
+        default_factory=list,
+        description="The day as one list in time order: every stop, charge, return to reload "
+        "and break, each with its arrival, start and departure, the state of charge, the "
+        "payload and the energy there, and the driving so far (what stops, charges, reloads "
+        "and breaks hold, by kind).",
     )
     totals: Totals = Field(..., description="The whole round.")
     battery: BatteryOut = Field(..., description="Whether the battery holds out with its reserve.")

@@ -511,6 +511,42 @@ class BreakResult(Result):
     )
 
 
+#: What a van does at a visit of its day.
+VisitKindName = Literal["stop", "charge", "reload", "break"]
+
+
+class VisitResult(Result):
+    """One visit of the day, in time order: a stop, a charge, a return to reload or a break."""
+
+    kind: VisitKindName = Field(
+        ...,
+        description="stop; charge (at a charger, or the depot's — reloaded meanwhile when the "
+        "van came back for both: see payload_after_kg); reload (back at the depot for the "
+        "next trip's load); break (the driver's, parked where the van is).",
+    )
+    id: str = Field(
+        ...,
+        description="Where: the stop's id, the charger's (\"depot\" for the depot's), the "
+        "depot's for a reload, the place the van stands at for a break.",
+    )
+    arrive: dt.datetime = Field(..., description="Arrival (a break: its start), local time.")
+    start: dt.datetime = Field(
+        ...,
+        description="The service, the charge or the reload begins, after any wait for a window "
+        "or a charger's opening (and half the plug-in), local time.",
+    )
+    depart: dt.datetime = Field(..., description="Departure (a break: its end), local time.")
+    soc_arrival: float = Field(..., description="State of charge on arrival [–].")
+    soc_departure: float = Field(..., description="State of charge when leaving [–].")
+    payload_after_kg: float = Field(..., description="Payload aboard when leaving [kg].")
+    energy_kwh: dict[str, float] = Field(
+        ..., description="Energy of each consumer from arrival to departure [kWh]."
+    )
+    driving_s: float = Field(
+        ..., description="Driving time since the day's departure, on arrival [s]."
+    )
+
+
 class DayProfile(Result):
     """The round minute by minute, from departure to return (the paper's Fig. 8)."""
 
@@ -590,6 +626,7 @@ class PlanResult:
     charges: list[ChargeResult] = field(default_factory=list)
     reloads: list[ReloadResult] = field(default_factory=list)
     breaks: list[BreakResult] = field(default_factory=list)
+    visits: list[VisitResult] = field(default_factory=list)
 
 
 UnassignedReason = Literal[

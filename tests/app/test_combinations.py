@@ -64,6 +64,45 @@ def check_rules(
     assert len(trips) == len(route["reloads"]) + 1
     assert route["battery"]["feasible"]
     assert route["battery"]["min_soc"] >= route["battery"]["reserve_soc"] - 1e-9
+    check_visits(route)
+
+
+def check_visits(route: dict[str, Any]) -> None:
+    """The day as one list agrees with its stops, charges, reloads and breaks: each in time
+    order, at the same moments and states of charge, and the driving so far is the legs'."""
+    visits = route["visits"]
+    assert [v["arrive"] for v in visits] == sorted(v["arrive"] for v in visits)
+    by_kind = {
+        kind: [v for v in visits if v["kind"] == kind]
+        for kind in ("stop", "charge", "reload", "break")
+    }
+    stops = [
+        {
+            "id": s["id"],
+            "arrive": s["arrival"],
+            "start": s["service_start"],
+            "depart": s["departure"],
+            "soc_arrival": s["soc_arrival"],
+            "soc_departure": s["soc_departure"],
+            "payload_after_kg": s["payload_after_kg"],
+        }
+        for s in route["stops"]
+    ]
+    assert [{k: v[k] for k in stops[0]} for v in by_kind["stop"]] == stops
+    charges = [(c["charger_id"], c["arrive"], c["depart"]) for c in route["charges"]]
+    assert [(v["id"], v["arrive"], v["depart"]) for v in by_kind["charge"]] == charges
+    reloaded = {v["arrive"] for v in by_kind["reload"]} | {
+        v["arrive"]
+        for v in by_kind["charge"]
+        if v["arrive"] in {r["arrive"] for r in route["reloads"]}
+    }
+    assert sorted(reloaded) == sorted(r["arrive"] for r in route["reloads"])
+    assert [(v["arrive"], v["depart"]) for v in by_kind["break"]] == [
+        (b["start"], b["end"]) for b in route["breaks"]
+    ]
+    for visit in by_kind["stop"]:
+        driven = sum(leg["duration_s"] for leg in route["legs"] if leg["arrive"] <= visit["arrive"])
+        assert visit["driving_s"] == pytest.approx(driven)
 
 
 @pytest.fixture

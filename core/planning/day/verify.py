@@ -41,6 +41,8 @@ from core.planning.model import (
     Solved,
     StopResult,
     UnassignedReason,
+    VisitKindName,
+    VisitResult,
 )
 from core.routing.roads import LegRoute
 
@@ -262,6 +264,39 @@ class _Split:
             for q in self.timeline.reloaded_at
         ]
 
+    def visits(self) -> list[VisitResult]:
+        """The day's visits and breaks in time order."""
+        soc, places, timeline = self.simulated.soc, self.scene.places, self.timeline
+        driven = np.concatenate(([0], np.cumsum(timeline.arrive - timeline.depart)))
+        out = []
+
+        def visit(kind: VisitKindName, place: int, b: int, s: int, c: int, k: int) -> None:
+            out.append(
+                VisitResult(
+                    kind=kind,
+                    id=DEPOT_CHARGER_ID if kind == "charge" and place == 0 else places[place].id,
+                    arrive=self.moment(b),
+                    start=self.moment(s),
+                    depart=self.moment(c),
+                    soc_arrival=float(soc[b]),
+                    soc_departure=float(soc[c]),
+                    payload_after_kg=float(timeline.payload[c]),
+                    energy_kwh=self.span_kwh(b, c),
+                    driving_s=float(driven[k]) * PLAN_DT_S,
+                )
+            )
+
+        for k, place in enumerate(self.order[1:-1]):
+            kind = self.itinerary.kind(k + 1, len(self.problem.stops))
+            if kind in ("stop", "charge", "reload"):
+                b, c = int(timeline.arrive[k]), int(timeline.leave[k])
+                visit(kind, place, b, int(timeline.serve[k]), c, k + 1)
+        for rest in timeline.breaks:
+            b, c = round(rest.start_s / PLAN_DT_S), round(rest.end_s / PLAN_DT_S)
+            k = int(np.searchsorted(timeline.depart, c))  # the leg it comes before
+            visit("break", self.order[min(k, len(self.order) - 1)], b, b, c, k)
+        return sorted(out, key=lambda v: (v.arrive, v.depart))
+
     def profile(self) -> DayProfile:
         size = self.simulated.time_s.size
         every = max(round(PROFILE_STEP_S / PLAN_DT_S), 1)
@@ -321,6 +356,7 @@ class _Split:
             itinerary=self.itinerary,
             charges=self.charges(),
             reloads=self.reloads(),
+            visits=self.visits(),
             breaks=[
                 BreakResult(
                     start=self.moment(round(b.start_s)),
