@@ -274,24 +274,44 @@ def simulate(
     trace = _driven(
         van, speed_mps, dt_s, grade, payload_kg, door_openings, parked, heading_deg, charging
     )
-    speed, n = trace.speed, trace.speed.size
-    end_s = (n - 1) * dt_s
-    check_representable(start, end_s)
-    time_s = np.arange(n) * dt_s
+    n = trace.speed.size
+    check_representable(start, (n - 1) * dt_s)
     outside = _environment(start, location, van, weather, n - 1, dt_s)
     power, box, cab_gap_j = _consumers(van, trace, dt_s, outside, box_start_c)
-    soc, verdict, loss_j, charges = _battery(van, power, dt_s, outside, trace.charging)
     departs_depot = van.precondition_at_depot and box_start_c is None
     grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c)
+    return _result(
+        trace,
+        dt_s,
+        outside,
+        (power, box),
+        _battery(van, power, dt_s, outside, trace.charging),
+        grid_j / battery_model.JOULES_PER_KWH if departs_depot else 0.0,
+    )
+
+
+def _result(
+    trace: _Trace,
+    dt_s: float,
+    outside: _Environment,
+    consumers: tuple[dict[str, FloatArray], BoxResult],
+    battery: tuple[FloatArray, battery_model.BatteryVerdict, float, list[ChargeOutcome]],
+    grid_kwh: float,
+) -> SimulationResult:
+    """The simulation's answer from its parts: the trace, the outside, each consumer's power
+    [W] and the box, the battery (state of charge, verdict, loss [J], charges) and the
+    pre-conditioning from the grid [kWh]."""
+    (power, box), (soc, verdict, loss_j, charges) = consumers, battery
+    n = trace.speed.size
     return SimulationResult(
-        time_s=time_s,
-        speed_mps=speed,
+        time_s=np.arange(n) * dt_s,
+        speed_mps=trace.speed,
         power_w=power,
         energy_kwh=_energy_kwh(power, dt_s),
         battery_loss_kwh=loss_j / battery_model.JOULES_PER_KWH,
-        grid_kwh=grid_j / battery_model.JOULES_PER_KWH if departs_depot else 0.0,
-        distance_m=trace_distance_m(speed, dt_s),
-        duration_s=end_s,
+        grid_kwh=grid_kwh,
+        distance_m=trace_distance_m(trace.speed, dt_s),
+        duration_s=(n - 1) * dt_s,
         soc=soc,
         battery=verdict,
         box=box,
