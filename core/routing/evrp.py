@@ -92,7 +92,8 @@ class VehicleKind:
     they set off from, their earliest departure and latest return to the depot; what their
     first trip may deliver (less when they set off loaded in part), and for vehicles that come
     back to reload, the place that return is (the depot's row, its service the reload's time)
-    and their most trips."""
+    and their most trips; the time to charge one unit of energy at each place for them (their
+    charging curve; None: the instance's)."""
 
     count: int
     energy: FloatArray
@@ -105,6 +106,7 @@ class VehicleKind:
     aboard: float = math.inf
     reload: int = -1
     max_trips: int = 1
+    charge_time: FloatArray | None = None
 
     def trips_carried(self, demand: FloatArray, route: Sequence[int]) -> bool:
         """Whether ``route`` (customers, :attr:`reload` between trips) keeps to the trips and
@@ -149,7 +151,8 @@ class EvrpInstance:
     customers, stations
         The customers' and the stations' indices.
     charge_time
-        Time to charge one unit of energy at each place (finite; read at the stations).
+        Time to charge one unit of energy at each place (finite; read at the stations), for
+        the kinds that do not say their own.
     kinds
         The fleet.
     fewest_vehicles
@@ -167,6 +170,11 @@ class EvrpInstance:
     charge_time: FloatArray
     kinds: list[VehicleKind]
     fewest_vehicles: bool = True
+
+    def charge_time_of(self, kind: int) -> FloatArray:
+        """Time to charge one unit of energy at each place for vehicles of ``kind``."""
+        own = self.kinds[kind].charge_time
+        return self.charge_time if own is None else own
 
 
 @dataclass(frozen=True)
@@ -283,7 +291,7 @@ class _Priced:
         self.evaluations = 0
         self.squares = 0
         self.memo: dict[tuple[float, int, tuple[int, ...]], Charged] = {}
-        self.facts = [_facts(instance, kind) for kind in instance.kinds]
+        self.facts = [_facts(instance, k) for k in range(len(instance.kinds))]
         stations = np.array(instance.stations, np.int64)
         self.candidates = station_candidates(instance.distance, stations)
 
@@ -569,9 +577,10 @@ class _Search:
         return EvrpSolution(routes, distance, sorted(self.left), ended)
 
 
-def _facts(instance: EvrpInstance, kind: VehicleKind) -> RouteFacts:
-    """What routes of ``kind`` are evaluated on: its energies and battery, its departure,
-    its latest return as the depot's close."""
+def _facts(instance: EvrpInstance, k: int) -> RouteFacts:
+    """What routes of kind ``k`` are evaluated on: its energies, battery and charge times,
+    its departure, its latest return as the depot's close."""
+    kind = instance.kinds[k]
     due = instance.due.copy()
     due[0] = min(due[0], kind.due)
     return RouteFacts(
@@ -581,7 +590,7 @@ def _facts(instance: EvrpInstance, kind: VehicleKind) -> RouteFacts:
         ready=instance.ready,
         due=due,
         service=instance.service,
-        charge_time=instance.charge_time,
+        charge_time=instance.charge_time_of(k),
         battery=kind.battery,
         initial=kind.initial,
         start_time=kind.ready,

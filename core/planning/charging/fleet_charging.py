@@ -35,7 +35,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from core.params import ChargePoint
+from core.params import BatteryParams, ChargePoint
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, charge_curve
 from core.planning.day.estimates import cost_matrix, energy_matrix_j
@@ -160,10 +160,8 @@ def charging_instance(
     ready, due, service = _windows(day, len(place_of), stations, place_of, points)
     for reload_s, q in reload_place.items():
         service[q] = reload_s
-    kinds, vans_of = _kinds(day, legs, arcs, reload_place)
-    charge_time = np.zeros(len(place_of))
-    for q in stations:
-        charge_time[q] = _seconds_per_joule(day, points[place_of[q]])
+    chargers = {q: points[place_of[q]] for q in stations}
+    kinds, vans_of = _kinds(day, legs, (arcs, len(place_of)), reload_place, chargers)
     instance = EvrpInstance(
         distance=arc_cost[arcs].astype(float) * unit_value,
         duration=duration[arcs],
@@ -173,7 +171,7 @@ def charging_instance(
         demand=np.concatenate([day.demand_g, np.zeros(len(place_of) - n)]).astype(float),
         customers=[k for k in day.stop_nodes if k not in day.unreachable],
         stations=stations,
-        charge_time=charge_time,
+        charge_time=_charge_times(problem.van.battery, chargers, len(place_of)),  # its start's
         kinds=kinds,
         fewest_vehicles=minimize_vehicles,
     )
@@ -208,11 +206,17 @@ def _reload_s(day: FleetDay, v: int) -> float:
 
 
 def _kinds(
-    day: FleetDay, legs: Legs, arcs: tuple[np.ndarray, ...], reload_place: dict[float, int]
+    day: FleetDay,
+    legs: Legs,
+    places: tuple[tuple[np.ndarray, ...], int],
+    reload_place: dict[float, int],
+    chargers: dict[int, ChargePoint],
 ) -> tuple[list[VehicleKind], list[list[int]]]:
     """The fleet's kinds — vans alike in estimates, shift, start, what they carry at first
     and their trips — and their vans; a return to reload draws the van's standing loads for
-    the reload's time."""
+    the reload's time; each kind charges at ``chargers`` (by the search's place) along its
+    own charging curve. ``places``: the search's places as arcs of the day's, and how many."""
+    arcs, size = places
     groups: dict[tuple[object, ...], list[int]] = {}
     for v in day.vans:
         problem = day.shifts[v].problem
@@ -246,15 +250,26 @@ def _kinds(
                 aboard=float(payload_units_down(start_payload_kg(problem))),
                 reload=reload,
                 max_trips=problem.max_trips,
+                charge_time=_charge_times(battery, chargers, size),
             )
         )
     return kinds, list(groups.values())
 
 
-def _seconds_per_joule(day: FleetDay, point: ChargePoint) -> float:
-    """Time to charge a joule at ``point`` [s/J]: the first van's charging curve at the
+def _charge_times(
+    battery: BatteryParams, chargers: dict[int, ChargePoint], size: int
+) -> np.ndarray:
+    """Time to charge a joule [s/J] at each of the search's ``size`` places, at the
+    ``chargers`` (by place) along the ``battery``'s curve."""
+    seconds_per_j = np.zeros(size)
+    for q, point in chargers.items():
+        seconds_per_j[q] = _seconds_per_joule(battery, point)
+    return seconds_per_j
+
+
+def _seconds_per_joule(battery: BatteryParams, point: ChargePoint) -> float:
+    """Time to charge a joule at ``point`` [s/J]: the ``battery``'s charging curve at the
     point's power, from its reserve to :data:`CHARGE_TIME_SOC`."""
-    battery = day.shifts[0].problem.van.battery
     curve = charge_curve(battery, point.power_kw * WATTS_PER_KW)
     top = max(CHARGE_TIME_SOC, battery.min_soc + 0.05)
     joules = (top - battery.min_soc) * battery.usable_capacity_kwh * JOULES_PER_KWH
@@ -375,7 +390,7 @@ def _verified(
         v = free[route.kind].pop(0)
         order = [charging.place_of[visit.place] for visit in route.visits]
         charges = {
-            q: _visit(charging.points[order[q]], visit.charge, charging.instance, visit.place)
+            q: _visit(charging, route.kind, order[q], visit.place, visit.charge)
             for q, visit in enumerate(route.visits)
             if 0 < q < len(order) - 1 and visit.place in charging.instance.stations
         }
@@ -393,10 +408,14 @@ def _verified(
     return Charging(routes, results, removed, solution.ended), short
 
 
-def _visit(point: ChargePoint, charge_j: float, instance: EvrpInstance, q: int) -> ChargeVisit:
-    return ChargeVisit(
-        instance.service[q], charge_j * float(instance.charge_time[q]), point.power_kw
-    )
+def _visit(
+    charging: ChargingInstance, kind: int, place: int, q: int, charge_j: float
+) -> ChargeVisit:
+    """The charge of ``charge_j`` [J] at the search's place ``q`` (the day's ``place``) by a
+    van of ``kind``, at its charging curve."""
+    instance = charging.instance
+    charge_s = charge_j * float(instance.charge_time_of(kind)[q])
+    return ChargeVisit(instance.service[q], charge_s, charging.points[place].power_kw)
 
 
 def _held(

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop
-from core.planning.charging.fleet_charging import Bookings
+from core.planning.charging.fleet_charging import Bookings, charging_instance
 from core.planning.day.timeline import MAX_DRIVING_S
 from core.planning.day.verify import Failure
 from core.planning.fleet.planner import plan_fleet
@@ -21,6 +21,7 @@ from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_
 from tests.core.planning.test_breaks import driving_between_breaks_s
 from tests.core.planning.test_recharge import summer_day
 from tests.utils.fleets import DEPOT
+from tests.utils.fleets import day_of as cluster_day
 from tests.utils.fleets import fleet as cluster_fleet
 from tests.utils.fleets import two_clusters as clusters
 from tests.utils.fleets import van as cluster_van
@@ -179,3 +180,27 @@ def test_a_stop_the_charging_verification_left_out_goes_to_an_idle_van(monkeypat
     assert [s.id for s in alone.plan.stops] == [stop] and alone.vehicle_id == "van-1"
     assert len(charged.plan.stops) == 5 and charged.plan.charges
     assert all(r.plan.battery.feasible for r in result.routes)
+
+
+def test_each_kind_of_van_charges_along_its_own_curve_in_the_search():
+    """A van that takes 11 kW and one that takes 150 kW at the same 150 kW charger: the
+    search charges each joule in its own time — 150 / 11 as long for the slow one, from
+    the reserve to 80 % where both curves are flat (the charging curve's constant part)."""
+    stops, matrix = clusters()
+    depot = DEPOT.model_copy(update={"charger": ChargePoint(power_kw=150, points=2)})
+    slow = BatteryParams(usable_capacity_kwh=40.0, max_charge_power_kw=11.0)
+    fast = BatteryParams(usable_capacity_kwh=40.0, max_charge_power_kw=150.0)
+    problem = cluster_fleet(
+        stops,
+        [cluster_van("slow", battery=slow), cluster_van("fast", battery=fast)],
+        matrix=matrix,
+    ).model_copy(update={"depot": depot})
+    instance = charging_instance(cluster_day(problem), cluster_day(problem).duration_s, True)
+    (station,) = instance.instance.stations
+    kinds = {
+        problem.vehicles[vans[0]].id: instance.instance.charge_time_of(k)[station]
+        for k, vans in enumerate(instance.vans_of)
+    }
+    assert kinds["slow"] / kinds["fast"] == pytest.approx(150 / 11, rel=1e-6)
+    # a joule at 150 kW takes 1 / 150,000 s (stored at the charging efficiency)
+    assert kinds["fast"] == pytest.approx(1 / 150_000 / fast.charging_efficiency, rel=1e-6)

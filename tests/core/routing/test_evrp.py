@@ -132,6 +132,19 @@ def test_a_window_that_charging_makes_unreachable_is_no_route():
     assert penalised.cost(3.0) == pytest.approx(80.0 + 30.0)
 
 
+def test_each_kind_charges_at_its_own_time_per_energy():
+    # the customer at 20 + t·10 + 20: 60 with the instance's 2 per unit, 70 with a kind's 3
+    due = np.array([1000.0, 60.0, 1000.0])
+    inst = on_a_line(due=due)
+    slow = replace(inst.kinds[0], charge_time=np.full(3, 3.0))
+    assert charged(inst, [1]).distance == pytest.approx(80.0)
+    assert charged(replace(inst, kinds=[slow]), [1]) is NO_ROUTE
+    fast = replace(inst.kinds[0], charge_time=np.full(3, 1.0))
+    assert charged(
+        replace(inst, due=np.array([1000.0, 50.0, 1000.0]), kinds=[fast]), [1]
+    ).distance == pytest.approx(80.0)
+
+
 def test_no_station_within_reach_and_too_much_load_are_no_route():
     far = instance([(0, 0), (40, 0), (0, 60)], "dcf")  # the station is farther than the way
     assert charged(far, [1]) is NO_ROUTE
