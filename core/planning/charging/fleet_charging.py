@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import datetime as dt
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -59,12 +59,16 @@ from core.routing.units import payload_units_down
 
 #: State of charge the charge time per joule is taken up to (the curve's constant part).
 CHARGE_TIME_SOC = 0.8
-#: The share of each van's battery (and of its charge at departure) the search plans with:
-#: the estimates do not see every draw of the simulation (the weather through the day, the
-#: standing loads while waiting). Small: a route the simulation finds short makes its kind's
-#: battery smaller by the shortfall (:func:`charging_routes`), and every percent held back is
-#: range lost where the estimates are right (0.9 cost c101 4 % distance, r101 a van).
+#: The share of each van's battery (and of its charge at departure) the search plans with when
+#: no route found without charging says how far the estimates fall short of the simulation
+#: (:func:`battery_margin`): the estimates do not see every draw of the simulation (the weather
+#: through the day, the standing loads while waiting). Small: a route the simulation finds
+#: short makes its kind's battery smaller by the shortfall (:func:`charging_routes`), and every
+#: percent held back is range lost where the estimates are right (0.9 cost c101 4 % distance,
+#: r101 a van).
 BATTERY_MARGIN = 0.98
+#: The least share of the battery the search plans with, however short the estimates fell.
+MIN_BATTERY_MARGIN = 0.85
 #: Searches at most (the first, then again after routes the simulation refused for their
 #: battery), the first's share of the work, and how many times what a route fell below its
 #: reserve its kind of van's battery is made smaller after.
@@ -133,10 +137,11 @@ class ChargingInstance:
 
 
 def charging_instance(
-    day: FleetDay, times_s: np.ndarray, minimize_vehicles: bool
+    day: FleetDay, times_s: np.ndarray, minimize_vehicles: bool, margin: float = BATTERY_MARGIN
 ) -> ChargingInstance:
     """The E-VRPTW instance of ``day`` (module docstring, item 1); ``times_s`` the driving
-    times the simulation taught the search (the day's solver places)."""
+    times the simulation taught the search (the day's solver places); ``margin`` the share of
+    each battery it plans with."""
     problem = day.shifts[0].problem
     places = day.scene.places
     points = charge_points(problem, places)
@@ -161,7 +166,7 @@ def charging_instance(
     for reload_s, q in reload_place.items():
         service[q] = reload_s
     chargers = {q: points[place_of[q]] for q in stations}
-    kinds, vans_of = _kinds(day, legs, (arcs, len(place_of)), reload_place, chargers)
+    kinds, vans_of = _kinds(day, legs, (arcs, len(place_of)), (reload_place, margin), chargers)
     instance = EvrpInstance(
         distance=arc_cost[arcs].astype(float) * unit_value,
         duration=duration[arcs],
@@ -209,14 +214,16 @@ def _kinds(
     day: FleetDay,
     legs: Legs,
     places: tuple[tuple[np.ndarray, ...], int],
-    reload_place: dict[float, int],
+    reloads: tuple[dict[float, int], float],
     chargers: dict[int, ChargePoint],
 ) -> tuple[list[VehicleKind], list[list[int]]]:
     """The fleet's kinds — vans alike in estimates, shift, start, what they carry at first
-    and their trips — and their vans; a return to reload draws the van's standing loads for
-    the reload's time; each kind charges at ``chargers`` (by the search's place) along its
-    own charging curve. ``places``: the search's places as arcs of the day's, and how many."""
-    arcs, size = places
+    and their trips — and their vans; a return to reload (``reloads``: its place by the
+    reload's time) draws the van's standing loads for the reload's time; each kind charges at
+    ``chargers`` (by the search's place) along its own charging curve, on the ``reloads``'
+    margin's share of its battery. ``places``: the search's places as arcs of the day's, and
+    how many."""
+    (arcs, size), (reload_place, margin) = places, reloads
     groups: dict[tuple[object, ...], list[int]] = {}
     for v in day.vans:
         problem = day.shifts[v].problem
@@ -241,8 +248,8 @@ def _kinds(
             VehicleKind(
                 count=len(vans),
                 energy=energy,
-                battery=estimates.budget_j * (1.0 - battery.min_soc) / window * BATTERY_MARGIN,
-                initial=estimates.budget_j * BATTERY_MARGIN if shift.battery_enforced else math.inf,
+                battery=estimates.budget_j * (1.0 - battery.min_soc) / window * margin,
+                initial=estimates.budget_j * margin if shift.battery_enforced else math.inf,
                 capacity=float(payload_units_down(problem.van.payload_kg)),
                 start=day.starts[v],
                 ready=day.shift_s[v][0],
@@ -304,10 +311,31 @@ def measure(
     return -served, vans, value
 
 
+def battery_margin(
+    day: FleetDay, routes: list[list[int]], results: Mapping[int, PlanResult]
+) -> float:
+    """The share of the batteries the charging search plans with: the least, over the
+    simulated routes found without charging (one trip, no charge), of the energy the estimates
+    gave the route over what the simulation drew from the battery — at most 1, at least
+    :data:`MIN_BATTERY_MARGIN`; :data:`BATTERY_MARGIN` when no route says."""
+    shares = []
+    for v, result in results.items():
+        if not routes[v] or result.charges or 0 in routes[v]:
+            continue
+        battery = result.battery
+        drawn_kwh = (result.legs[0].soc_start - battery.final_soc) * battery.usable_capacity_kwh
+        if drawn_kwh > 0:
+            estimated_kwh = day.estimates[v].route_energy_j(routes[v]) / JOULES_PER_KWH
+            shares.append(estimated_kwh / drawn_kwh)
+    if not shares:
+        return BATTERY_MARGIN
+    return min(max(min(shares), MIN_BATTERY_MARGIN), 1.0)
+
+
 def charging_routes(
     day: FleetDay,
     times_s: np.ndarray,
-    routes: list[list[int]],
+    found: tuple[list[list[int]], Mapping[int, PlanResult]],
     minimize_vehicles: bool,
     effort: Effort,
 ) -> Charging:
@@ -319,7 +347,10 @@ def charging_routes(
     again from ``routes`` (which hold without charging; the routes it found may not hold with
     the smaller battery even when charged), at most
     :data:`CHARGING_ROUNDS` times; the best verified routes are kept."""
-    charging = charging_instance(day, times_s, minimize_vehicles)
+    routes, results = found
+    charging = charging_instance(
+        day, times_s, minimize_vehicles, battery_margin(day, routes, results)
+    )
     kind_of = {v: k for k, vans in enumerate(charging.vans_of) for v in vans}
     kinds = charging.instance.kinds
     initial = [

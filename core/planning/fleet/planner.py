@@ -596,7 +596,7 @@ def _charged(
     charged = charging_routes(
         day,
         rules.travel_s,
-        routes,
+        (routes, results),
         minimize_vehicles,
         effort.share(CHARGING_SHARE).keeping(reserve_s / 2),
     )

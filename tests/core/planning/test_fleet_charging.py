@@ -13,7 +13,13 @@ import numpy as np
 import pytest
 
 from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop
-from core.planning.charging.fleet_charging import Bookings, charging_instance
+from core.planning.charging.fleet_charging import (
+    BATTERY_MARGIN,
+    MIN_BATTERY_MARGIN,
+    Bookings,
+    battery_margin,
+    charging_instance,
+)
 from core.planning.day.timeline import MAX_DRIVING_S
 from core.planning.day.verify import Failure
 from core.planning.fleet.planner import plan_fleet
@@ -204,3 +210,28 @@ def test_each_kind_of_van_charges_along_its_own_curve_in_the_search():
     assert kinds["slow"] / kinds["fast"] == pytest.approx(150 / 11, rel=1e-6)
     # a joule at 150 kW takes 1 / 150,000 s (stored at the charging efficiency)
     assert kinds["fast"] == pytest.approx(1 / 150_000 / fast.charging_efficiency, rel=1e-6)
+
+
+def test_the_search_plans_with_the_share_of_the_battery_the_estimates_earned():
+    """The routes found without charging, simulated, say how far the estimates fall short:
+    the charging search plans with the least share (estimated over drawn energy) of them, at
+    most the whole battery, at least MIN_BATTERY_MARGIN; BATTERY_MARGIN when no route says."""
+    stops, matrix = clusters()
+    day = cluster_day(cluster_fleet(stops, [cluster_van("a"), cluster_van("b")], matrix=matrix))
+    routes = [[1, 2, 3], [4, 5, 6]]
+    results = {v: day.simulate(v, route) for v, route in enumerate(routes)}
+    shares = []
+    for v, route in enumerate(routes):
+        result = results[v]
+        drawn_kwh = (result.legs[0].soc_start - result.battery.final_soc) * (
+            result.battery.usable_capacity_kwh
+        )
+        shares.append(day.estimates[v].route_energy_j(route) / 3.6e6 / drawn_kwh)
+    assert battery_margin(day, routes, results) == pytest.approx(
+        min(max(min(shares), MIN_BATTERY_MARGIN), 1.0)
+    )
+    # the summer day's standing loads drawn while parked: the estimates fall a little short
+    assert MIN_BATTERY_MARGIN < battery_margin(day, routes, results) < 1.0
+    assert battery_margin(day, [[], []], {}) == BATTERY_MARGIN
+    # a route that reloads says nothing of one trip's estimate
+    assert battery_margin(day, [[1, 0, 2], []], {0: results[0]}) == BATTERY_MARGIN
