@@ -73,7 +73,7 @@ def simulate_route(
     start
         Departure (zone-aware).
     roads
-        The road of each leg of ``order`` from a router, or None to generate the traces.
+        The road of each leg of the itinerary from a router, or None to generate the traces.
     solved
         How the order was found (reported as it is).
     windows_s
