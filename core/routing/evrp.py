@@ -14,7 +14,11 @@ and when, by when it is back, its battery and the energy of each arc for it.
    :data:`CHARGE_TIME_SHARE` of the time the arc's energy takes to charge (charging is time a
    route must find room for).
 2. **Stations on a route** (:mod:`core.routing.stations`): for a fixed order of customers, the
-   stations between them and how much to charge at each, by labels.
+   stations between them and how much to charge at each, by labels; a station takes no
+   charge while it is closed. **Shared points**: at a station with fewer points than the
+   fleet has vehicles, the routes book them in the order of their first charge there — each
+   waits for a point the routes before it leave free, or charges elsewhere
+   (:meth:`_Priced.booked`) —, and every solution the search keeps is booked so.
 3. **Search** on work — the route evaluations, by their size (:data:`EVALUATION_S`,
    :data:`SQUARE_S`) — capped by the deadline (Numba evaluates, Python searches): the
    customers of a route that cannot be charged are inserted where they cost least (left out
@@ -31,7 +35,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pyvrp
@@ -39,6 +43,7 @@ from pyvrp.stop import MaxIterations, MaxRuntime, MultipleCriteria
 
 from core.arrays import FloatArray
 from core.routing.effort import Effort, SearchEnd
+from core.routing.points import Closed, Span, full_spans
 from core.routing.stations import (
     NO_ROUTE,
     Charged,
@@ -157,6 +162,10 @@ class EvrpInstance:
         The fleet.
     fewest_vehicles
         Fewest vehicles before the least cost.
+    points
+        The stations where fewer vehicles than the fleet's can charge at once: how many.
+    closed
+        When stations take no charge (by station; none: always open).
     """
 
     distance: FloatArray
@@ -170,6 +179,8 @@ class EvrpInstance:
     charge_time: FloatArray
     kinds: list[VehicleKind]
     fewest_vehicles: bool = True
+    points: dict[int, int] = field(default_factory=dict)
+    closed: dict[int, list[Span]] = field(default_factory=dict)
 
     def charge_time_of(self, kind: int) -> FloatArray:
         """Time to charge one unit of energy at each place for vehicles of ``kind``."""
@@ -282,7 +293,8 @@ def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
 
 class _Priced:
     """What each route (kind, customers) costs with its stations, memoised, at the current
-    ``penalty`` per unit of time late (infinite: routes must keep their windows); the
+    ``penalty`` per unit of time late (infinite: routes must keep their windows) and with the
+    stations closed when they are (:meth:`booked`: the points the others take too); the
     evaluations and their sizes, the work they stand for."""
 
     def __init__(self, instance: EvrpInstance) -> None:
@@ -290,20 +302,45 @@ class _Priced:
         self.penalty = math.inf
         self.evaluations = 0
         self.squares = 0
-        self.memo: dict[tuple[float, int, tuple[int, ...]], Charged] = {}
+        self.memo: dict[tuple[object, ...], Charged] = {}
         self.facts = [_facts(instance, k) for k in range(len(instance.kinds))]
         stations = np.array(instance.stations, np.int64)
         self.candidates = station_candidates(instance.distance, stations)
+        self.size = len(instance.distance)
+        self.closed = Closed.of(instance.closed, self.size)
 
-    def charged(self, kind: int, route: list[int]) -> Charged:
-        key = (self.penalty, kind, tuple(route))
+    def charged(self, kind: int, route: list[int], closed: Closed | None = None) -> Charged:
+        closed = closed or self.closed
+        key = (self.penalty, kind, tuple(route), closed.key)
         if key not in self.memo:
             if len(self.memo) > MEMO_SIZE:
                 self.memo.clear()
-            self.memo[key] = self._evaluated(kind, route)
+            self.memo[key] = self._evaluated(kind, route, closed)
         return self.memo[key]
 
-    def _evaluated(self, kind: int, route: list[int]) -> Charged:
+    def booked(self, routes: Routes) -> list[Charged]:
+        """Each of ``routes`` with its stations, the points of the stations with few shared:
+        in the order of their first charge at one, each route charges where and when the
+        routes before it leave a point free (waiting for one, or at another station)."""
+        free = [self.charged(k, r) for k, r in routes]
+        shared = self.instance.points
+        firsts = {r: c.plugged_at(shared) for r, c in enumerate(free)}
+        using = sorted((min(t for _, t, _ in f), r) for r, f in firsts.items() if f)
+        if len(using) < 2:
+            return free
+        taken: dict[int, list[Span]] = {s: [] for s in shared}
+        out = list(free)
+        for _, r in using:
+            full = {s: full_spans(spans, shared[s]) for s, spans in taken.items()}
+            if any(full.values()):
+                for s, spans in self.instance.closed.items():
+                    full[s] = full.get(s, []) + spans
+                out[r] = self.charged(*routes[r], Closed.of(full, self.size))
+            for s, a, b in out[r].plugged_at(shared):
+                taken[s].append((a, b))
+        return out
+
+    def _evaluated(self, kind: int, route: list[int], closed: Closed) -> Charged:
         vehicle = self.instance.kinds[kind]
         route = vehicle.tidied(route)
         seq = np.array([vehicle.start, *route, 0], dtype=np.int64)
@@ -312,12 +349,12 @@ class _Priced:
         load = float(self.instance.demand[seq].sum())
         if not vehicle.trips_carried(self.instance.demand, route):
             return NO_ROUTE
-        cost, warp, gaps, charges = route_with_stations(
-            self.facts[kind], seq, self.candidates, self.penalty
+        cost, warp, gaps, charges, plugged = route_with_stations(
+            self.facts[kind], seq, self.candidates, closed, self.penalty
         )
         if not math.isfinite(cost):
             return NO_ROUTE
-        return Charged(float(cost), float(warp), load, seq, gaps, charges)
+        return Charged(float(cost), float(warp), load, seq, gaps, charges, plugged)
 
     def cost(self, kind: int, route: list[int]) -> float:
         """The route's cost with its stations and its penalised lateness; infinite when it
@@ -325,21 +362,19 @@ class _Priced:
         return self.charged(kind, route).cost(self.penalty)
 
 
-class _Search:
-    """The routes (kind, customers) and the customers left out, searched on their prices
-    (:class:`_Priced`)."""
+class _Solution:
+    """The routes (kind, customers) and the customers left out, on their prices
+    (:class:`_Priced`): what they cost together, and where a customer goes in."""
 
-    def __init__(self, instance: EvrpInstance, rng: np.random.Generator) -> None:
+    def __init__(self, instance: EvrpInstance) -> None:
         self.instance = instance
-        self.rng = rng
         self.routes: Routes = []
         self.left: list[int] = []
         self.priced = _Priced(instance)
         self.is_customer = frozenset(instance.customers)
         self.charged = self.priced.charged
         self.cost = self.priced.cost
-        self.moves = 0
-        self.best: tuple[tuple[int, int, float], Routes, list[int]] | None = None
+        self._booked: tuple[object, list[Charged]] = (None, [])
         inst = instance
         self.nearest = np.argsort(
             inst.distance[np.ix_(inst.customers, inst.customers)], axis=1, kind="stable"
@@ -349,16 +384,25 @@ class _Search:
             for n, c in enumerate(inst.customers)
         }
 
+    def booked(self) -> list[Charged]:
+        """The routes with their stations, the shared points booked (:meth:`_Priced.booked`;
+        remembered for the last routes)."""
+        key = (self.priced.penalty, tuple((k, tuple(r)) for k, r in self.routes))
+        if self._booked[0] != key:
+            self._booked = (key, self.priced.booked(self.routes))
+        return self._booked[1]
+
     def late(self) -> float:
-        return sum(self.charged(k, r).warp for k, r in self.routes)
+        return sum(c.warp for c in self.booked())
 
     def holds(self) -> bool:
-        return all(math.isfinite(self.cost(k, r)) for k, r in self.routes)
+        return all(math.isfinite(c.distance) for c in self.booked())
 
     def total(self) -> tuple[int, int, float]:
         """Customers left out, vehicles (when they count), cost."""
         vehicles = len(self.routes) if self.instance.fewest_vehicles else 0
-        return len(self.left), vehicles, sum(self.cost(k, r) for k, r in self.routes)
+        penalty = self.priced.penalty
+        return len(self.left), vehicles, sum(c.cost(penalty) for c in self.booked())
 
     def _customers(self, route: list[int]) -> list[int]:
         """The customers of ``route`` (not its returns to reload)."""
@@ -370,8 +414,9 @@ class _Search:
         return used < self.instance.kinds[kind].count
 
     def start(self, routes: Routes) -> None:
-        """The routes that hold (within each kind's count); the customers of those that do
-        not, inserted where best."""
+        """The routes that hold (within each kind's count; together, on the shared points:
+        else customers out of the first that does not, the farthest first); the customers of
+        those that do not, inserted where best."""
         left: list[int] = []
         for kind, customers in routes:
             route = list(customers)
@@ -392,9 +437,24 @@ class _Search:
                 left.append(worst)
             if self._customers(route):
                 self.routes.append((kind, route))
+        while not self.holds():
+            r = next(r for r, c in enumerate(self.booked()) if math.isinf(c.distance))
+            kind, route = self.routes[r]
+            worst = max(self._customers(route), key=lambda c: self.instance.distance[0, c])
+            self.routes[r] = (kind, [c for c in route if c != worst])
+            self.routes = [(k, r) for k, r in self.routes if self._customers(r)]
+            left.append(worst)
         served = {c for _, r in self.routes for c in r} | set(left)
         left += [c for c in self.instance.customers if c not in served]
-        self.left = [c for c in left if not self.insert(c)]
+        self.left = [c for c in left if not self._inserted_holding(c)]
+
+    def _inserted_holding(self, customer: int) -> bool:
+        """:meth:`insert` kept only when the routes hold together."""
+        saved = self._saved()
+        if self.insert(customer) and self.holds():
+            return True
+        self.routes, self.left = saved
+        return False
 
     def insert(self, customer: int, allow_new: bool = True) -> bool:
         """Put ``customer`` where it adds the least cost (a new route of a spare vehicle when
@@ -460,6 +520,19 @@ class _Search:
         bounds.sort()
         return bounds
 
+    def _saved(self) -> tuple[Routes, list[int]]:
+        return [(k, list(r)) for k, r in self.routes], list(self.left)
+
+
+class _Search(_Solution):
+    """The search over a :class:`_Solution` (step 3), on work; the best routes seen."""
+
+    def __init__(self, instance: EvrpInstance, rng: np.random.Generator) -> None:
+        super().__init__(instance)
+        self.rng = rng
+        self.moves = 0
+        self.best: tuple[tuple[int, int, float], Routes, list[int]] | None = None
+
     @property
     def spent_s(self) -> float:
         """The work done [reference s]: route evaluations by their size, and moves."""
@@ -512,9 +585,6 @@ class _Search:
         if self.best is None or total < self.best[0]:
             self.best = (total, [(k, list(r)) for k, r in self.routes], list(self.left))
 
-    def _saved(self) -> tuple[Routes, list[int]]:
-        return [(k, list(r)) for k, r in self.routes], list(self.left)
-
     def _eliminate(self, until: float, nth: int, effort: Effort) -> bool:
         """Empty the ``nth`` smallest route into the others, late at first, and search on the
         penalised lateness until none is late or the work done is ``until``; False (and nothing
@@ -547,7 +617,12 @@ class _Search:
         customers = self.instance.customers
         seed = int(self.rng.integers(len(customers)))
         if late_first:
-            late = [self._customers(r) for k, r in self.routes if self.charged(k, r).warp > 0]
+            booked = self.booked()
+            late = [
+                self._customers(r)
+                for (_, r), c in zip(self.routes, booked, strict=True)
+                if c.warp > 0
+            ]
             if late:
                 pick = late[int(self.rng.integers(len(late)))]
                 seed = customers.index(pick[int(self.rng.integers(len(pick)))])
@@ -572,8 +647,9 @@ class _Search:
         self.priced.penalty = math.inf
         if self.best is not None and self.best[0] < self.total():
             _, self.routes, self.left = self.best
-        routes = [EvrpRoute(k, self.charged(k, r).visits) for k, r in self.routes]
-        distance = sum(self.charged(k, r).distance for k, r in self.routes)
+        booked = self.booked()
+        routes = [EvrpRoute(k, c.visits) for (k, _), c in zip(self.routes, booked, strict=True)]
+        distance = sum(c.distance for c in booked)
         return EvrpSolution(routes, distance, sorted(self.left), ended)
 
 

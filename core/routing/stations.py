@@ -4,17 +4,20 @@ route's gaps (Numba).
 
 At most one station per gap, among the :data:`STATIONS_PER_GAP` with the least detour. A
 charge gives what the way to the next station (or the depot) takes — the least, so the least
-time. Labels of cost, time and battery on arrival are kept when no other is as good on all
-three (at most :data:`LABELS_PER_NODE`). The least cost that keeps every window, the battery
-and the latest return wins — or, with a penalty per unit of time late, the least cost plus the
-penalised lateness (Vidal et al.'s time warp, *Computers & OR* 40 (2013) 475). The labelling
-follows Keskin & Çatay, *Transportation Research C* 65 (2016) 111 (partial recharge) and
-Schneider, Stenger & Goeke, *Transportation Science* 48 (2014) 500.
+time. A station closed, or with every point taken by other vehicles, when a charge would
+start makes the vehicle wait for the first span with room for the whole charge
+(:class:`core.routing.points.Closed`). Labels of cost, time and battery on arrival are kept
+when no other is as good on all three (at most :data:`LABELS_PER_NODE`). The least cost that
+keeps every window, the battery and the latest return wins — or, with a penalty per unit of
+time late, the least cost plus the penalised lateness (Vidal et al.'s time warp, *Computers &
+OR* 40 (2013) 475). The labelling follows Keskin & Çatay, *Transportation Research C* 65 (2016)
+111 (partial recharge) and Schneider, Stenger & Goeke, *Transportation Science* 48 (2014) 500.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,6 +25,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from core.arrays import FloatArray
+from core.routing.points import Closed
 
 #: Stations considered on each gap between two places of a route, least detour first.
 STATIONS_PER_GAP = 4
@@ -78,7 +82,8 @@ class RouteFacts:
 class Charged:
     """A route with its stations: its cost, the time it is late in all (``warp``, only with a
     finite penalty), its load, and per gap between two places of ``seq`` (start, customers,
-    depot) the station visited (−1: none) and the energy charged there."""
+    depot) the station visited (−1: none), the energy charged there and when the vehicle is
+    plugged in there (from after any wait to its departure; NaN where none)."""
 
     distance: float
     warp: float
@@ -86,6 +91,7 @@ class Charged:
     seq: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     gaps: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     charges: FloatArray = field(default_factory=lambda: np.zeros(0))
+    plugged: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
 
     def cost(self, penalty: float) -> float:
         return self.distance + (penalty * self.warp if self.warp > 0 else 0.0)
@@ -100,6 +106,15 @@ class Charged:
                 visits.append(Visit(int(self.gaps[p]), float(self.charges[p])))
             visits.append(Visit(int(self.seq[p + 1]), 0.0))
         return visits
+
+    def plugged_at(self, stations: Mapping[int, int]) -> list[tuple[int, float, float]]:
+        """When the vehicle is plugged in at each of ``stations`` it charges at: (station,
+        from, to)."""
+        return [
+            (int(s), float(self.plugged[p, 0]), float(self.plugged[p, 1]))
+            for p, s in enumerate(self.gaps)
+            if s in stations
+        ]
 
 
 NO_ROUTE = Charged(math.inf, 0.0)
@@ -118,12 +133,14 @@ def route_with_stations(
     facts: RouteFacts,
     seq: NDArray[np.int64],
     candidates: NDArray[np.int64],
+    closed: Closed,
     penalty: float = math.inf,
-) -> tuple[float, float, NDArray[np.int64], FloatArray]:
+) -> tuple[float, float, NDArray[np.int64], FloatArray, FloatArray]:
     """``seq`` (start, customers in order, depot) with the stations and charges it needs at
     the least cost, plus ``penalty`` per unit of time late (a place reached after its window
-    is served at its close, the lateness counted; infinite: never late): its cost, lateness,
-    and per gap the station (−1: none) and the energy charged there. Infinite cost when no
+    is served at its close, the lateness counted; infinite: never late), a charge only where
+    and when ``closed`` has room for it: its cost, lateness, and per gap the station (−1:
+    none), the energy charged there and when plugged in (from, to). Infinite cost when no
     choice keeps the battery (and the windows)."""
     f = facts
     lab = np.zeros((1 + (seq.size - 1) * candidates.shape[2], LABELS_PER_NODE, _FIELDS))
@@ -141,6 +158,7 @@ def route_with_stations(
         f.initial,
         f.start_time,
         penalty,
+        (closed.ptr, closed.start, closed.end),
         lab,
     )
 
@@ -160,8 +178,9 @@ def _labels(
     initial: float,
     start_time: float,
     penalty: float,
+    closed: tuple[NDArray[np.int64], FloatArray, FloatArray],
     lab: FloatArray,
-) -> tuple[float, float, NDArray[np.int64], FloatArray]:
+) -> tuple[float, float, NDArray[np.int64], FloatArray, FloatArray]:
     """Labels over the route's charge points — the start (node 0), then station k of gap p
     (between ``seq[p]`` and ``seq[p + 1]``, node ``1 + p·K + k``), each extended in turn
     (:func:`_extend`); the best that reaches the depot, traced back (:func:`_traced`)."""
@@ -172,19 +191,47 @@ def _labels(
     lab[0, 0, _B] = initial
     lab[0, 0, _PREV] = -1.0
     count[0] = 1
+    _first_stations(seq, cost, dur, energy, due, cand, penalty, lab, count)
     best = np.array([np.inf, 0.0, 0.0, -1.0, -1.0, 0.0])  # cost, d, w, node, slot, charge
     for u in range(nodes):
         for li in range(count[u]):
             _extend(
                 u, li, seq, cost, dur, energy, ready, due, service, charge_time, cand,
-                battery, penalty, lab, count, best,
+                battery, penalty, closed, lab, count, best,
             )  # fmt: skip
     gaps = np.full(m, -1, dtype=np.int64)
     charges = np.zeros(m)
+    plugged = np.full((m, 2), np.nan)
     if best[3] < 0:
-        return np.inf, 0.0, gaps, charges
-    _traced(best, lab, seq, cand, gaps, charges)
-    return best[1], best[2], gaps, charges
+        return np.inf, 0.0, gaps, charges, plugged
+    _traced(best, lab, seq, cand, (service, charge_time, closed), (gaps, charges, plugged))
+    return best[1], best[2], gaps, charges, plugged
+
+
+@njit(cache=True)
+def _first_stations(
+    seq: NDArray[np.int64],
+    cost: FloatArray,
+    dur: FloatArray,
+    energy: FloatArray,
+    due: FloatArray,
+    cand: NDArray[np.int64],
+    penalty: float,
+    lab: FloatArray,
+    count: NDArray[np.int64],
+) -> None:
+    """The start's label driven to each station straight from it (before the first customer;
+    it charges nothing there)."""
+    here, end, t0, b0 = seq[0], seq[seq.size - 1], lab[0, 0, _T], lab[0, 0, _B]
+    for k in range(cand.shape[2]):
+        s = cand[seq[0], seq[1], k]
+        arrive = t0 + dur[here, s]
+        late = max(arrive - due[end], 0.0)
+        if energy[here, s] <= b0 + _EPS and not (not np.isfinite(penalty) and late > _EPS):
+            _add_label(
+                lab, count, 1 + k, cost[here, s], late, min(arrive, due[end]),
+                b0 - energy[here, s], penalty, 0, 0, 0.0,
+            )  # fmt: skip
 
 
 @njit(cache=True)
@@ -202,6 +249,7 @@ def _extend(
     cand: NDArray[np.int64],
     battery: float,
     penalty: float,
+    closed: tuple[NDArray[np.int64], FloatArray, FloatArray],
     lab: FloatArray,
     count: NDArray[np.int64],
     best: FloatArray,
@@ -216,15 +264,6 @@ def _extend(
     d0, w0, t0, b0 = lab[u, li, _D], lab[u, li, _W], lab[u, li, _T], lab[u, li, _B]
     if u == 0:
         here, first, limit, plug = seq[0], 1, b0, 0.0
-        for k in range(k_max):  # a station straight from the start, before the first customer
-            s = cand[seq[0], seq[1], k]
-            arrive = t0 + dur[here, s]
-            late = max(arrive - due[end], 0.0)
-            if energy[here, s] <= b0 + _EPS and not (hard and late > _EPS):
-                _add_label(
-                    lab, count, 1 + k, cost[here, s], late, min(arrive, due[end]),
-                    b0 - energy[here, s], penalty, u, li, 0.0,
-                )  # fmt: skip
     else:
         gap = (u - 1) // k_max
         here, first, limit = cand[seq[gap], seq[gap + 1], (u - 1) % k_max], gap + 1, battery
@@ -239,7 +278,9 @@ def _extend(
             return
         if p == m:  # back at the depot
             x = max(0.0, used - b0)
-            leave = t0 + plug + charge_time[here] * x
+            leave = _plugged(u, here, t0, plug + charge_time[here] * x, closed)[1]
+            if not np.isfinite(leave):
+                return
             _, late = _walk(seq, first, m, here, leave, dur, ready, due, service)
             if hard and late > _EPS:
                 return
@@ -254,7 +295,9 @@ def _extend(
             if to_s > limit + _EPS:
                 continue
             x = max(0.0, to_s - b0)
-            leave = t0 + plug + charge_time[here] * x
+            leave = _plugged(u, here, t0, plug + charge_time[here] * x, closed)[1]
+            if not np.isfinite(leave):
+                continue
             leave, late = _walk(seq, first, p, here, leave, dur, ready, due, service)
             arrive = leave + dur[node, s]
             late += max(arrive - due[end], 0.0)
@@ -267,21 +310,50 @@ def _extend(
 
 
 @njit(cache=True)
+def _plugged(
+    u: int,
+    here: int,
+    arrive: float,
+    length: float,
+    closed: tuple[NDArray[np.int64], FloatArray, FloatArray],
+) -> tuple[float, float]:
+    """Plugged in at ``here`` (label node ``u``; the start, 0, charges nothing) for
+    ``length``, arriving at ``arrive``: from the first moment with room for it in ``closed``
+    to then plus ``length`` (infinite when none)."""
+    start = arrive
+    if u > 0:
+        ptr, shut, opens = closed
+        for i in range(ptr[here], ptr[here + 1]):
+            if opens[i] <= start:
+                continue
+            if shut[i] >= start + length:
+                break
+            start = opens[i]  # closed (or full) before the charge is done: after it
+    return start, start + length
+
+
+@njit(cache=True)
 def _traced(
     best: FloatArray,
     lab: FloatArray,
     seq: NDArray[np.int64],
     cand: NDArray[np.int64],
-    gaps: NDArray[np.int64],
-    charges: FloatArray,
+    at: tuple[FloatArray, FloatArray, tuple[NDArray[np.int64], FloatArray, FloatArray]],
+    out: tuple[NDArray[np.int64], FloatArray, FloatArray],
 ) -> None:
-    """The stations and charges of the best label's path, gap by gap (in place)."""
+    """The stations, charges and when plugged in (``at`` the stations' plug-in times, charge
+    times per unit and closed spans) of the best label's path, gap by gap (into ``out``)."""
+    service, charge_time, closed = at
+    gaps, charges, plugged = out
     k_max = cand.shape[2]
     u, li, x = int(best[3]), int(best[4]), best[5]
     while u > 0:
         gap = (u - 1) // k_max
-        gaps[gap] = cand[seq[gap], seq[gap + 1], (u - 1) % k_max]
+        here = cand[seq[gap], seq[gap + 1], (u - 1) % k_max]
+        gaps[gap] = here
         charges[gap] = x
+        length = service[here] + charge_time[here] * x
+        plugged[gap, 0], plugged[gap, 1] = _plugged(u, here, lab[u, li, _T], length, closed)
         x = lab[u, li, _X]
         u, li = int(lab[u, li, _PREV]), int(lab[u, li, _PREV_L])
 

@@ -11,14 +11,17 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    its origin: :mod:`core.planning.day.estimates`); each van kind's battery between its reserve
    and full, what it holds at departure, its payload, its shift and where it sets off; each
    charger's charge time per joule (the van's charging curve at the charger's power, reserve
-   to 80 %) and its plug-in time; each stop's window (the first opening to the last close).
+   to 80 %), its plug-in time, its points when fewer than the vans (the search shares them
+   out) and when it is closed (outside its opening hours); each stop's window (the first
+   opening to the last close).
 2. **The search** starts from the better of its own routes of the stops, found with part of
    the charging time in the arcs (when every van leaves the depot), and the routes the fleet's
    search found without charging (the stops left out inserted where they cost least), and
    serves every stop it can, then fewest vans (when asked), then the objective.
 3. **Verification**: each route is simulated with its charges fitted to what the simulation
    says each stretch takes (:func:`core.planning.day.recharge.with_charges`), the charge points
-   free only between the other vans' charges (:class:`Bookings`). A route the simulation
+   free only between the other vans' charges as simulated (:class:`Bookings`: the search
+   shared them out on its estimates). A route the simulation
    refuses loses the stop it names, else the costliest, until it holds
    (:func:`core.planning.search.repair.repair`).
 
@@ -35,13 +38,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from core.params import BatteryParams, ChargePoint
+from core.params import BatteryParams, ChargePoint, Charger
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, charge_curve
 from core.planning.day.estimates import cost_matrix, energy_matrix_j
 from core.planning.day.recharge import Busy
 from core.planning.day.scene import charge_points
 from core.planning.day.start_state import start_payload_kg
+from core.planning.day.timeline import seconds_after
 from core.planning.day.verify import Failure, route_failure
 from core.planning.itinerary import ChargeVisit, Itinerary
 from core.planning.model import DEPOT_CHARGER_ID, PlanResult
@@ -55,6 +59,7 @@ from core.routing.evrp import (
     solve_evrptw,
 )
 from core.routing.geo import Legs
+from core.routing.points import Span, full_spans, outside
 from core.routing.units import payload_units_down
 
 #: State of charge the charge time per joule is taken up to (the curve's constant part).
@@ -101,25 +106,8 @@ class Bookings:
         out: dict[int, list[tuple[dt.datetime, dt.datetime]]] = {}
         for place, spans in self.spans.items():
             others = [(a, b) for a, b, v in spans if v != van_id]
-            out[place] = _full(others, self.points[place].points)
+            out[place] = full_spans(others, self.points[place].points)
         return out
-
-
-def _full(
-    spans: list[tuple[dt.datetime, dt.datetime]], points: int
-) -> list[tuple[dt.datetime, dt.datetime]]:
-    """When at least ``points`` of ``spans`` overlap."""
-    events = sorted([(a, 1) for a, _ in spans] + [(b, -1) for _, b in spans])
-    full, taken, since = [], 0, None
-    for moment, step in events:
-        taken += step
-        if taken >= points and since is None:
-            since = moment
-        elif taken < points and since is not None:
-            if moment > since:
-                full.append((since, moment))
-            since = None
-    return full
 
 
 @dataclass(frozen=True)
@@ -179,6 +167,8 @@ def charging_instance(
         charge_time=_charge_times(problem.van.battery, chargers, len(place_of)),  # its start's
         kinds=kinds,
         fewest_vehicles=minimize_vehicles,
+        points={q: c.points for q, c in chargers.items() if c.points < len(day.vans)},
+        closed={q: _closed_s(day, c) for q, c in chargers.items() if _closed_s(day, c)},
     )
     return ChargingInstance(instance, place_of, vans_of, points, frozenset(reload_place.values()))
 
@@ -200,6 +190,18 @@ def _windows(
     for q in stations:
         service[q] = points[place_of[q]].plug_minutes * 60.0
     return ready, due, service
+
+
+def _closed_s(day: FleetDay, point: ChargePoint) -> list[Span]:
+    """When ``point`` is closed [s after the day's reference]: outside its opening hours."""
+    date = day.shifts[0].problem.date
+    hours = point.opening_hours if isinstance(point, Charger) else []
+    return outside(
+        [
+            (seconds_after(date, w.start, day.reference), seconds_after(date, w.end, day.reference))
+            for w in hours
+        ]
+    )
 
 
 def _reloads(day: FleetDay, v: int) -> bool:

@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
+import math
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop
+from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop, TimeWindow
 from core.planning.charging.fleet_charging import (
     BATTERY_MARGIN,
     MIN_BATTERY_MARGIN,
@@ -235,3 +236,24 @@ def test_the_search_plans_with_the_share_of_the_battery_the_estimates_earned():
     assert battery_margin(day, [[], []], {}) == BATTERY_MARGIN
     # a route that reloads says nothing of one trip's estimate
     assert battery_margin(day, [[1, 0, 2], []], {0: results[0]}) == BATTERY_MARGIN
+
+
+def test_the_search_knows_each_chargers_points_and_opening_hours():
+    """Two vans, the depot's charger of one point and a charger on the way of two, open
+    10:00–12:00 and 14:00–16:00: the search shares the depot's one point (the way's two are
+    as many as the vans: never short) and takes no charge on the way outside its hours, in
+    seconds after the first departure (08:00)."""
+    stops, _ = clusters()
+    hours = [TimeWindow(start="10:00", end="12:00"), TimeWindow(start="14:00", end="16:00")]
+    way = Charger(id="way", lat=48.2, lon=16.45, power_kw=50, points=2, opening_hours=hours)
+    depot = DEPOT.model_copy(update={"charger": ChargePoint(power_kw=22, points=1)})
+    problem = cluster_fleet(stops, [cluster_van("a"), cluster_van("b")], chargers=[way])
+    day = cluster_day(problem.model_copy(update={"depot": depot}))
+    charging = charging_instance(day, day.duration_s, True)
+    (at_depot,) = [q for q in charging.instance.stations if charging.place_of[q] == 0]
+    (on_way,) = [q for q in charging.instance.stations if charging.place_of[q] != 0]
+    assert charging.instance.points == {at_depot: 1}
+    h = 3600.0
+    assert charging.instance.closed == {
+        on_way: [(-math.inf, 2 * h), (4 * h, 6 * h), (8 * h, math.inf)]
+    }

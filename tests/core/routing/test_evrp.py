@@ -145,6 +145,49 @@ def test_each_kind_charges_at_its_own_time_per_energy():
     ).distance == pytest.approx(80.0)
 
 
+def test_a_station_closed_when_the_charge_would_start_makes_the_vehicle_wait():
+    # open: plugged in 20–40 (10 units at 2 per unit), the customer at 60, again 80–120.
+    # Closed 15–35: the charge cannot be done before 35 → 35–55, the customer at 75, again
+    # 95–135 (the second charge fits after the closing).
+    assert charged(on_a_line(), [1]).plugged_at({2: 1}) == [(2, 20.0, 40.0), (2, 80.0, 120.0)]
+    shut = on_a_line(closed={2: [(15.0, 35.0)]})
+    assert charged(shut, [1]).plugged_at({2: 1}) == [(2, 35.0, 55.0), (2, 95.0, 135.0)]
+    # the customer's window closing at 70 is kept when open, not when closed 15–35
+    due = np.array([1000.0, 70.0, 1000.0])
+    assert charged(on_a_line(due=due), [1]).distance == pytest.approx(80.0)
+    assert charged(on_a_line(due=due, closed={2: [(15.0, 35.0)]}), [1]) is NO_ROUTE
+    # closed for good from 100: the second charge (95–135) has no room
+    assert charged(on_a_line(closed={2: [(100.0, math.inf)]}), [1]) is NO_ROUTE
+
+
+def two_at_one_point(due: float, points: int) -> EvrpInstance:
+    """Two customers 40 out (one vehicle each: capacity 1), the only station halfway with
+    ``points`` points, each customer's window closing at ``due``."""
+    inst = instance([(0, 0), (40, 0), (20, 0), (40, 0)], "dcfc", capacity=1.0)
+    return replace(
+        inst, due=np.array([1000.0, due, 1000.0, due]), points={2: points} if points < 4 else {}
+    )
+
+
+def test_vehicles_at_a_one_point_station_take_turns_in_the_search():
+    # each plugged in at 20 for 20 alone; at one point the second waits for the first: 40–60,
+    # its customer at 80 — and again on the way back, after the first
+    priced = _Priced(two_at_one_point(1000.0, 1))
+    first, second = priced.booked([(0, [1]), (0, [3])])
+    assert first.plugged_at({2: 1}) == [(2, 20.0, 40.0), (2, 80.0, 120.0)]
+    assert second.plugged_at({2: 1}) == [(2, 40.0, 60.0), (2, 120.0, 160.0)]
+    # two points: no waiting
+    free = _Priced(two_at_one_point(1000.0, 2)).booked([(0, [1]), (0, [3])])
+    assert [c.plugged_at({2: 2}) for c in free] == [first.plugged_at({2: 1})] * 2
+    # windows closing at 70: one point serves one customer (the second would be there at
+    # 80), two serve both
+    effort = Effort.starting_now(0.5, 60.0)
+    one = solve_evrptw(two_at_one_point(70.0, 1), effort)
+    assert one.vehicles == 1 and len(one.left_out) == 1
+    two = solve_evrptw(two_at_one_point(70.0, 2), effort)
+    assert two.vehicles == 2 and not two.left_out
+
+
 def test_no_station_within_reach_and_too_much_load_are_no_route():
     far = instance([(0, 0), (40, 0), (0, 60)], "dcf")  # the station is farther than the way
     assert charged(far, [1]) is NO_ROUTE
