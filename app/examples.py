@@ -240,6 +240,17 @@ def _calibration_example() -> dict[str, Any]:
 CALIBRATION_EXAMPLE: dict[str, Any] = _calibration_example()
 
 
+#: The morning round carrying chilled dairy (+6 °C at most, ATP Annex 3) loaded at 4 °C, and
+#: carrying frozen food (−18 °C, brief rises of 3 K), each box simulated with its unit's
+#: capacity and the goods' own temperature.
+CHILLED_PLAN_EXAMPLE: dict[str, Any] = PLAN_EXAMPLE | {
+    "cargo_box": {"product": "chilled-dairy", "load_temperature_c": 4.0, "mode": "dynamic"}
+}
+FROZEN_PLAN_EXAMPLE: dict[str, Any] = PLAN_EXAMPLE | {
+    "cargo_box": {"product": "frozen", "mode": "dynamic", "refrigeration_capacity_w": 4000.0}
+}
+
+
 #: The request examples of /v1/plans and /v1/fleet-plans as Swagger shows them: name →
 #: (summary, body). Their descriptions are their answers' figures (:func:`describe`), recorded
 #: by ``make openapi`` and checked against a fresh run by the tests: they cannot drift.
@@ -253,6 +264,11 @@ PLAN_EXAMPLES: dict[str, tuple[str, dict[str, Any]]] = {
         "The same day with chargers on the way: it stops at the fast one",
         EN_ROUTE_CHARGING_EXAMPLE,
     ),
+    "vienna-8-stops-chilled-dairy": (
+        "The morning round with chilled dairy: the goods' temperature and the cold chain",
+        CHILLED_PLAN_EXAMPLE,
+    ),
+    "vienna-8-stops-frozen": ("The morning round with frozen food", FROZEN_PLAN_EXAMPLE),
 }
 FLEET_EXAMPLES: dict[str, tuple[str, dict[str, Any]]] = {
     "vienna-two-vans": (
@@ -288,10 +304,17 @@ def describe(answer: dict[str, Any]) -> str:
         + f" ({sum(c['minutes'] for c in charges):.0f} min)"
     )
     back = answer["legs"][-1]["arrive"][11:16]
+    chain = answer.get("cold_chain")
+    goods = (
+        ""
+        if chain is None
+        else f" The goods between {chain['product_min_c']:.1f} and {chain['product_max_c']:.1f} "
+        f"°C: the cold chain {chain['verdict']}."
+    )
     return (
         f"{energy['total']:.1f} kWh in all ({energy['refrigeration']:.1f} of them for the "
         f"refrigeration) on a {battery['usable_capacity_kwh']:g} kWh battery; {charged}; back "
-        f"at {back}, its lowest charge {battery['min_soc']:.0%}."
+        f"at {back}, its lowest charge {battery['min_soc']:.0%}.{goods}"
     )
 
 

@@ -8,7 +8,7 @@ from app import connectors
 from app.operations.answers import attribution, battery, box, energy, weather
 from app.operations.limits import check_round, search_limits
 from app.operations.vans import van_of
-from app.schemas.base import EnergySeries, EnergyShare, LineString, Point
+from app.schemas.base import ColdChainOut, EnergySeries, EnergyShare, LineString, Point
 from app.schemas.plans import (
     BreakOut,
     ChargeOut,
@@ -92,6 +92,7 @@ def plan_response(
             result.minutes_above_product_limit,
             result.product_limit_c,
         ),
+        cold_chain=None if result.cold_chain is None else ColdChainOut(**dict(result.cold_chain)),
         solver=SolverOut(**dict(result.solved), objective=result.objective),
         distance_source=result.distance_source,
         warnings=result.warnings,

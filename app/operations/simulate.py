@@ -2,19 +2,25 @@
 
 from __future__ import annotations
 
+import math
+from typing import Any
+
 import numpy as np
 
 from app import connectors
 from app.operations.answers import battery, box, energy, weather
 from app.operations.vans import van_of
-from app.schemas.base import ConsumptionWhPerKm, PowerSeries
+from app.schemas.base import ColdChainOut, ConsumptionWhPerKm, PowerSeries
 from app.schemas.simulate import Series, SimulateRequest, SimulateResponse
 from app.settings import Settings
+from core.arrays import FloatArray
 from core.exceptions import LimitExceededError
-from core.params import STREET_TYPES
+from core.params import STREET_TYPES, CargoBoxParams
+from core.physics.cold_chain import check_cold_chain
 from core.physics.cycles import generate_leg
 from core.physics.simulate import check_trace, simulate
 from core.physics.weather import forecast_for
+from core.planning.model import ColdChainResult
 
 #: Shortest distance for which energy per km is reported [m].
 MIN_DISTANCE_FOR_PER_KM_M = 1.0
@@ -80,6 +86,10 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
             speed_mps=result.speed_mps.tolist(),
             power_w=PowerSeries(**{k: [0.0, *p.tolist()] for k, p in result.power_w.items()}),
             soc=result.soc.tolist(),
+            air_temperature_c=_at_samples(result.box.temperature_c),
+            product_temperature_c=(
+                None if result.box.product_c is None else _at_samples(result.box.product_c)
+            ),
         )
     dynamic = van.cargo_box.mode == "dynamic"
     return SimulateResponse(
@@ -94,7 +104,26 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
             result.box.minutes_above_limit if dynamic else None,
             van.cargo_box.product_limit_c,
         ),
+        cold_chain=_cold_chain(van.cargo_box, result.box.product_c, request.dt_s),
         series=series,
         grid_kwh=result.grid_kwh,
         warnings=[*warnings, *result.warnings],
+    )
+
+
+def _at_samples(per_step: FloatArray) -> list[Any]:
+    """A box trace at each step's end as one value per sample (the first sample's: the first
+    step's end); NaN (no goods aboard) as null."""
+    values = [float(per_step[0]), *per_step.tolist()] if per_step.size else []
+    return [v if math.isfinite(v) else None for v in values]
+
+
+def _cold_chain(
+    box: CargoBoxParams, product_c: FloatArray | None, dt_s: float
+) -> ColdChainOut | None:
+    band = box.band
+    if band is None or product_c is None:
+        return None
+    return ColdChainOut(
+        **dict(ColdChainResult.of(band, check_cold_chain(band, product_c, dt_s), dt_s))
     )

@@ -33,6 +33,7 @@ from core.params import (
 )
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import DayWeather, WeatherSource
+from core.planning.model import ColdChainResult
 from core.routing.geo import DistanceSource
 
 
@@ -202,7 +203,7 @@ class VanRequest(ApiModel):
         return self._changed(profile)
 
     def _changed(self, base: VanParams) -> VanParams:
-        sections = {
+        sections: dict[str, tuple[type[Params], Params]] = {
             "vehicle": (VehicleParams, base.vehicle),
             "cargo_box": (CargoBoxParams, base.cargo_box),
             "battery": (BatteryParams, base.battery),
@@ -218,7 +219,7 @@ class VanRequest(ApiModel):
             }
             try:
                 with inside_validation():  # pydantic's own errors, one per field
-                    built[section] = model(**(current.model_dump() | wanted))
+                    built[section] = model(**model.changed_values(current.model_dump(), wanted))
             except ValidationError as error:
                 for item in error.errors():
                     path = field_path(item["loc"])
@@ -370,6 +371,10 @@ class WeatherOut(ApiModel):
     days: list[DayWeatherOut] = Field(
         default_factory=list, description="Each local day of a round, with its own weather."
     )
+
+
+class ColdChainOut(ApiModel, ColdChainResult):
+    """Whether the goods stayed inside their band while aboard."""
 
 
 class BoxOut(ApiModel):

@@ -11,6 +11,7 @@ from app.schemas.base import (
     AttributionOut,
     BatteryOut,
     BoxOut,
+    ColdChainOut,
     DistanceSourceOut,
     EnergyKwh,
     EnergySeries,
@@ -161,6 +162,11 @@ class PlanResponse(ApiModel):
     weather: WeatherOut = Field(..., description="The weather the round was simulated with.")
     timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
     box: BoxOut = Field(..., description="Cargo-box temperatures (dynamic mode).")
+    cold_chain: ColdChainOut | None = Field(
+        None,
+        description="Whether the goods stayed inside their product band while aboard "
+        "(cargo_box.product); null: the box has no product.",
+    )
     solver: SolverOut = Field(..., description="How the tour search ended.")
     distance_source: DistanceSourceOut
     warnings: list[str] = Field(

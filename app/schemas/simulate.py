@@ -11,6 +11,7 @@ from app.schemas.base import (
     ApiModel,
     BatteryOut,
     BoxOut,
+    ColdChainOut,
     ConsumptionWhPerKm,
     EnergyKwh,
     NotNull,
@@ -105,6 +106,16 @@ class Series(ApiModel):
         ..., description="Each consumer's mean power over the step ending at each sample [W]."
     )
     soc: list[float] = Field(..., description="State of charge at each sample [–].")
+    air_temperature_c: list[float] = Field(
+        default_factory=list,
+        description="The box air at each sample [°C] (steady box: the set-point; the first "
+        "sample's is the first step's).",
+    )
+    product_temperature_c: list[float | None] | None = Field(
+        None,
+        description="The goods at each sample [°C], null while none are aboard; null without "
+        "a product in cargo_box.",
+    )
 
 
 class SimulateResponse(ApiModel):
@@ -119,6 +130,11 @@ class SimulateResponse(ApiModel):
     battery: BatteryOut = Field(..., description="Whether the battery holds out with its reserve.")
     weather: WeatherOut = Field(..., description="The weather the trace was simulated with.")
     box: BoxOut = Field(..., description="Cargo-box temperatures (dynamic mode).")
+    cold_chain: ColdChainOut | None = Field(
+        None,
+        description="Whether the goods stayed inside their product band (cargo_box.product); "
+        "null: the box has no product.",
+    )
     series: Series | None = Field(None, description="The time series, when include_series is true.")
     grid_kwh: float = Field(
         0.0, description="Energy from the grid to pre-condition cab and box before the start."

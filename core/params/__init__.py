@@ -61,6 +61,7 @@ from core.params.places import (
     TimeWindow,
 )
 from core.params.presets import DEFAULT_PRESET, PRESETS, Preset, get_preset
+from core.params.product import PRODUCT_CLASSES, Product, ProductBand, ProductClass, product_band
 from core.params.van import (
     MIN_SOC_WINDOW,
     BatteryParams,
@@ -91,6 +92,7 @@ __all__ = [
     "NEDC_DURATION_S",
     "NORMAL_DRIVER",
     "PRESETS",
+    "PRODUCT_CLASSES",
     "STREET_TYPES",
     "BatteryParams",
     "CargoBoxParams",
@@ -108,6 +110,9 @@ __all__ = [
     "Params",
     "Place",
     "Preset",
+    "Product",
+    "ProductBand",
+    "ProductClass",
     "Result",
     "RoadMatrix",
     "Stop",
@@ -125,4 +130,5 @@ __all__ = [
     "field_path",
     "get_preset",
     "inside_validation",
+    "product_band",
 ]

@@ -184,6 +184,12 @@ class Params(BaseModel):
     def _few_unknown(cls, data: Any) -> Any:
         return few_unknown(cls, data)
 
+    @classmethod
+    def changed_values(cls, current: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
+        """The values of ``current`` (a model's dump) with ``changes`` (a request's changes to a
+        preset) applied."""
+        return current | changes
+
     def __init__(self, **data: Any) -> None:
         if _INSIDE_VALIDATION.get():
             super().__init__(**data)

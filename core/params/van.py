@@ -3,12 +3,13 @@ refrigeration unit (§3), the traction battery."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
-from pydantic import Field, ValidationError, ValidationInfo, field_validator
+from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from core.params.base import Params
+from core.params.product import PRODUCT_CLASSES, Celsius, Product, ProductBand, product_band
 
 
 class VehicleParams(Params):
@@ -160,8 +161,34 @@ class CargoBoxParams(Params):
         description="Total heat-transfer area A [m²] (eq. 11); null means 2·(A_r + A_s + A_b); at "
         "least 0.1 m².",
     )
+    product: Product | None = Field(
+        None,
+        description="What the box carries: a class with its legal band (frozen, ice-cream: "
+        "Directive 89/108/EEC and ATP Annex 2; the chilled classes: ATP Annex 3), or a band "
+        "{min_c, max_c, excursion_c}. Given: the goods' own temperature is simulated beside the "
+        "air's and each plan says whether the cold chain holds. Null: the air alone, as before.",
+    )
+    load_temperature_c: Celsius | None = Field(
+        None,
+        ge=-40,
+        le=40,
+        description="The goods' temperature when loaded [°C]; null: the product band's middle.",
+    )
+    product_conductance_w_kgk: float = Field(
+        0.16,
+        ge=0.001,
+        le=10,
+        description="Heat between the box air and the goods per kelvin and kg of goods "
+        "[W/(kg·K)]: with the goods' specific heat it sets how fast they follow the air "
+        "(2,300 J/(kg·K) / 0.16 ≈ 4 h, the half-cooling times of packaged foods in a moving "
+        "air stream, ASHRAE Handbook — Refrigeration ch. 20).",
+    )
     setpoint_c: float = Field(
-        4.0, ge=-40, le=25, description="Cargo-air set-point ϑ_CB [°C]; 4 °C for chilled goods."
+        4.0,
+        ge=-40,
+        le=25,
+        description="Cargo-air set-point ϑ_CB [°C]; 4 °C for chilled goods. With a product and "
+        "no set-point: the product band's middle; inside the band.",
     )
     cop: float = Field(
         1.5,
@@ -287,6 +314,57 @@ class CargoBoxParams(Params):
         le=100_000,
         description="Most heat the box heater delivers [W] (dynamic mode only); at least 10 W.",
     )
+
+    @classmethod
+    def changed_values(cls, current: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
+        """A product changed without a set-point takes its band's (:meth:`_setpoint_of_product`),
+        not the preset's."""
+        if changes.get("product") is not None and "setpoint_c" not in changes:
+            current = {k: v for k, v in current.items() if k != "setpoint_c"}
+        return current | changes
+
+    @model_validator(mode="before")
+    @classmethod
+    def _setpoint_of_product(cls, data: Any) -> Any:
+        """The set-point a product's band implies when the request gives none."""
+        if isinstance(data, dict) and "setpoint_c" not in data:
+            product = data.get("product")
+            band = PRODUCT_CLASSES.get(product) if isinstance(product, str) else None
+            if isinstance(product, ProductBand):
+                band = product
+            elif isinstance(product, dict):
+                low, high = product.get("min_c"), product.get("max_c")
+                if isinstance(low, int | float) and isinstance(high, int | float):
+                    return data | {"setpoint_c": 0.5 * (low + high)}
+            if band is not None:
+                return data | {"setpoint_c": band.middle_c}
+        return data
+
+    @field_validator("setpoint_c")
+    @classmethod
+    def _setpoint_in_band(cls, value: float, info: ValidationInfo) -> float:
+        product = info.data.get("product")
+        if product is not None:
+            band = product_band(product)
+            if not band.min_c <= value <= band.max_c:
+                raise ValueError(
+                    f"setpoint_c must be inside the product's band, {band.min_c:g} to "
+                    f"{band.max_c:g} °C"
+                )
+        return value
+
+    @property
+    def band(self) -> ProductBand | None:
+        """The product's band (None: no product)."""
+        return None if self.product is None else product_band(self.product)
+
+    @property
+    def load_c(self) -> float:
+        """The goods' temperature when loaded [°C]."""
+        if self.load_temperature_c is not None:
+            return self.load_temperature_c
+        band = self.band
+        return self.setpoint_c if band is None else band.middle_c
 
     @field_validator("product_limit_c")
     @classmethod

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from core.arrays import FloatArray
 from core.params import GRAVITY_MPS2, CargoBoxParams
+from core.physics.cold_chain import two_nodes
 
 #: Specific gas constant of dry air [J/(kg·K)].
 AIR_GAS_CONSTANT_J_KGK = 287.05
@@ -85,9 +86,15 @@ def door_heat_w(box: CargoBoxParams, ambient_c: ArrayLike, box_c: ArrayLike) -> 
 def heat_capacity_j_k(box: CargoBoxParams, payload_kg: ArrayLike) -> FloatArray:
     """Thermal capacity of the box and its contents ``m·c_p`` [J/K] (eq. 9): cargo, box air and
     the box structure that follows the air."""
-    air = air_density_kg_m3(box.setpoint_c) * box.volume_m3 * AIR_SPECIFIC_HEAT_J_KGK
     cargo = np.asarray(payload_kg, dtype=float) * box.cargo_specific_heat_j_kgk
-    return cargo + air + box.structure_heat_capacity_j_k
+    return cargo + air_heat_capacity_j_k(box)
+
+
+def air_heat_capacity_j_k(box: CargoBoxParams) -> float:
+    """Thermal capacity of the box air at the set-point and the structure that follows it
+    [J/K]."""
+    air = float(air_density_kg_m3(box.setpoint_c)) * box.volume_m3 * AIR_SPECIFIC_HEAT_J_KGK
+    return air + box.structure_heat_capacity_j_k
 
 
 #: Highest COP of the 'carnot' model [–]: small lifts (a cool day) cannot make the compressor
@@ -152,6 +159,9 @@ class BoxResult:
         Highest cargo-air temperature [°C].
     minutes_above_limit
         Time with the cargo air above ``product_limit_c`` [min].
+    product_c
+        The goods' temperature at the end of each step [°C], NaN while none are aboard
+        (:mod:`core.physics.cold_chain`); None: the box has no product.
     """
 
     power_w: FloatArray
@@ -161,6 +171,7 @@ class BoxResult:
     temperature_c: FloatArray
     max_temperature_c: float
     minutes_above_limit: float
+    product_c: FloatArray | None = None
 
 
 #: Step of the dynamic box integration [s]: the box's time constant is many minutes even with
@@ -177,6 +188,7 @@ def refrigeration(
     payload_kg: ArrayLike,
     dt_s: float,
     initial_c: float | None = None,
+    product_start_c: float | None = None,
 ) -> BoxResult:
     """Heat loads and electric refrigeration power of every step (eqs 9–12).
 
@@ -197,6 +209,9 @@ def refrigeration(
     initial_c
         Temperature of the box structure and air at the start [°C] (the cargo is loaded at the
         set-point); None: everything at the set-point (pre-cooled at the depot).
+    product_start_c
+        With a product: the goods' temperature at the start [°C]; None: as loaded
+        (``load_temperature_c``).
 
     Notes
     -----
@@ -215,6 +230,12 @@ def refrigeration(
     door_conductance = np.zeros_like(ambient_c)
     is_open = door_open > 0
     door_conductance[is_open] = door_open[is_open] * door_conductance_w_k(box, ambient_c[is_open])
+    if box.product is not None:
+        air_c = box.setpoint_c if initial_c is None else initial_c
+        goods_c = box.load_c if product_start_c is None else product_start_c
+        return _with_goods(
+            box, (ambient_c, solar_heat, door_conductance), payload_kg, dt_s, (air_c, goods_c)
+        )
     if box.mode == "steady":
         temperature, cooling, heating = _steady(
             box, ambient_c, solar_heat, door_conductance, dt_s, initial_c
@@ -240,6 +261,43 @@ def refrigeration(
         temperature_c=temperature,
         max_temperature_c=float(temperature.max()) if temperature.size else box.setpoint_c,
         minutes_above_limit=float(above.sum() * dt_s / 60.0),
+    )
+
+
+def _with_goods(
+    box: CargoBoxParams,
+    outside: tuple[FloatArray, FloatArray, FloatArray],
+    payload_kg: ArrayLike,
+    dt_s: float,
+    start_c: tuple[float, float],
+) -> BoxResult:
+    """The box of two nodes, air and goods (:mod:`core.physics.cold_chain`), its unit a
+    thermostat on the air at the set-point; ``outside``: the ambient [°C], the sun [W] and the
+    door's conductance [W/K] of each step; ``start_c``: the air's and the goods' [°C]."""
+    ambient_c, solar_heat, door_conductance = outside
+    conductance = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2 + door_conductance
+    nodes = two_nodes(
+        box,
+        air_heat_capacity_j_k(box),
+        conductance,
+        ambient_c + solar_heat / conductance,
+        np.broadcast_to(np.asarray(payload_kg, dtype=float), ambient_c.shape).astype(float),
+        np.full(ambient_c.shape, box.setpoint_c),
+        dt_s,
+        start_c,
+    )
+    air = nodes.air_c
+    cop = refrigeration_cop(box, ambient_c, air)
+    power = nodes.removed_w / cop + nodes.added_w / box.heating_cop + box.standby_power_w
+    return BoxResult(
+        power_w=power,
+        wall_heat_w=wall_heat_w(box, ambient_c, air),
+        solar_heat_w=solar_heat,
+        door_heat_w=door_conductance * (ambient_c - air),
+        temperature_c=air,
+        max_temperature_c=float(air.max()) if air.size else box.setpoint_c,
+        minutes_above_limit=float((air > box.product_limit_c).sum() * dt_s / 60.0),
+        product_c=nodes.product_c,
     )
 
 

@@ -227,6 +227,7 @@ def simulate(
     heading_deg: ArrayLike | None = None,
     charging: Sequence[ChargingSpell] = (),
     box_start_c: float | None = None,
+    product_start_c: float | None = None,
 ) -> SimulationResult:
     """Simulate every consumer of the van along one speed trace (paper Fig. 7, one leg).
 
@@ -266,6 +267,9 @@ def simulate(
         The box's temperature at the start [°C] of a van already under way (its day planned
         again): its cab is at temperature and nothing is pre-conditioned. None: the start is
         the depot's departure (``precondition_at_depot`` says how the van leaves).
+    product_start_c
+        With a product in the box: the goods' temperature at the start [°C]; None: as loaded
+        (``cargo_box.load_temperature_c``).
 
     Returns
     -------
@@ -277,7 +281,7 @@ def simulate(
     n = trace.speed.size
     check_representable(start, (n - 1) * dt_s)
     outside = _environment(start, location, van, weather, n - 1, dt_s)
-    power, box, cab_gap_j = _consumers(van, trace, dt_s, outside, box_start_c)
+    power, box, cab_gap_j = _consumers(van, trace, dt_s, outside, (box_start_c, product_start_c))
     departs_depot = van.precondition_at_depot and box_start_c is None
     grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c)
     return _result(
@@ -404,11 +408,12 @@ def _consumers(
     trace: _Trace,
     dt_s: float,
     outside: _Environment,
-    box_start_c: float | None = None,
+    start_c: tuple[float | None, float | None] = (None, None),
 ) -> tuple[dict[str, FloatArray], BoxResult, float]:
     """Each consumer's power over each step [W] (:data:`CONSUMERS`), the box, and the energy a
-    cab at the outside temperature needs to reach 20 °C [J] (none for a van under way,
-    ``box_start_c`` given)."""
+    cab at the outside temperature needs to reach 20 °C [J] (none for a van under way: the
+    box's temperature given in ``start_c``, beside the goods')."""
+    box_start_c, product_start_c = start_c
     speed = trace.speed
     n_steps = speed.size - 1
     box = refrigeration(
@@ -423,6 +428,7 @@ def _consumers(
             if box_start_c is not None
             else (None if van.precondition_at_depot else outside.start_c)
         ),
+        product_start_c=product_start_c,
     )
     cab_gap_j = 0.0 if box_start_c is not None else _cab_gap_j(van, outside.start_c)
     power = {

@@ -27,6 +27,7 @@ from core.params import (
     Objective,
     Params,
     Place,
+    ProductBand,
     Result,
     RoadMatrix,
     Stop,
@@ -37,6 +38,7 @@ from core.params import (
     clock_field,
 )
 from core.physics.battery import BatteryVerdict
+from core.physics.cold_chain import ColdChainCheck
 from core.physics.weather import DayWeather, WeatherSource
 from core.planning.itinerary import Itinerary
 from core.routing.effort import Effort, SearchEnd
@@ -243,6 +245,13 @@ class StartState(Params):
     box_temperature_c: float | None = Field(
         None, ge=-40, le=60, description="The box's temperature now [°C]; absent: the set-point."
     )
+    product_temperature_c: float | None = Field(
+        None,
+        ge=-40,
+        le=60,
+        description="The goods' temperature now [°C] (a box with a product); absent: as "
+        "loaded (cargo_box.load_temperature_c).",
+    )
     payload_kg: float | None = Field(
         None, ge=0, le=40_000, description="Payload aboard now [kg]; absent: the van's payload_kg."
     )
@@ -439,6 +448,66 @@ class LegResult(Result):
     )
 
 
+class Temperatures(Result):
+    """A temperature on arrival and on departure."""
+
+    arrival: float | None = Field(..., description="On arrival [°C]; null: nothing to measure.")
+    departure: float | None = Field(
+        ..., description="On departure [°C]; null: nothing to measure (no goods left aboard)."
+    )
+
+
+class ColdChainResult(Result):
+    """Whether the goods stayed inside their band while aboard (a box with a product)."""
+
+    verdict: Literal["holds", "breaks"] = Field(
+        ...,
+        description="holds: the goods never left [min_c, max_c + excursion_c] while aboard; "
+        "breaks: they did (first_break_stop and reason say where and why).",
+    )
+    product_min_c: float | None = Field(
+        ..., description="The coldest the goods were while aboard [°C]."
+    )
+    product_max_c: float | None = Field(
+        ..., description="The warmest the goods were while aboard [°C]."
+    )
+    minutes_outside_band: float = Field(
+        ..., description="Time with the goods outside [min_c, max_c] [min]."
+    )
+    first_break_stop: str | None = Field(
+        ...,
+        description="The stop being driven to or served when the chain first breaks (null: "
+        "it holds, or it breaks after the last stop).",
+    )
+    first_break_s: float | None = Field(
+        None, description="When it first breaks, seconds after the start; null: it holds."
+    )
+    reason: str | None = Field(..., description="Why it breaks, in words; null: it holds.")
+    min_c: float = Field(..., description="The band's floor [°C].")
+    max_c: float = Field(..., description="The band's ceiling [°C].")
+    excursion_c: float = Field(..., description="The brief rise above max_c tolerated [K].")
+
+    @classmethod
+    def of(
+        cls, band: ProductBand, check: ColdChainCheck, dt_s: float, stop: str | None = None
+    ) -> ColdChainResult:
+        """The verdict of ``check`` (over steps of ``dt_s``) on ``band``; ``stop``: where it
+        first breaks."""
+        step = check.first_break_step
+        return cls(
+            verdict="holds" if check.holds else "breaks",
+            product_min_c=check.product_min_c,
+            product_max_c=check.product_max_c,
+            minutes_outside_band=check.minutes_outside_band,
+            first_break_stop=stop,
+            first_break_s=None if step is None else (step + 1) * dt_s,
+            reason=check.reason,
+            min_c=band.min_c,
+            max_c=band.max_c,
+            excursion_c=band.excursion_c,
+        )
+
+
 class StopResult(Result):
     """One stop of the round, in visiting order."""
 
@@ -465,6 +534,13 @@ class StopResult(Result):
     )
     lat: float = Field(..., description="The stop's latitude, as requested [°].")
     lon: float = Field(..., description="The stop's longitude, as requested [°].")
+    air_temperature_c: Temperatures = Field(
+        ..., description="The box air on arrival and on departure [°C] (steady box: set-point)."
+    )
+    product_temperature_c: Temperatures | None = Field(
+        None,
+        description="The goods on arrival and on departure [°C]; null: the box has no product.",
+    )
 
 
 class ChargeResult(Result):
@@ -627,6 +703,7 @@ class PlanResult:
     reloads: list[ReloadResult] = field(default_factory=list)
     breaks: list[BreakResult] = field(default_factory=list)
     visits: list[VisitResult] = field(default_factory=list)
+    cold_chain: ColdChainResult | None = None
 
 
 UnassignedReason = Literal[

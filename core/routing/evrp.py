@@ -324,6 +324,8 @@ class _Priced:
         routes before it leave a point free (waiting for one, or at another station)."""
         free = [self.charged(k, r) for k, r in routes]
         shared = self.instance.points
+        if not shared:
+            return free
         firsts = {r: c.plugged_at(shared) for r, c in enumerate(free)}
         using = sorted((min(t for _, t, _ in f), r) for r, f in firsts.items() if f)
         if len(using) < 2:

@@ -116,6 +116,13 @@ def box_start_c(problem: PlanProblem) -> float | None:
     return state.box_temperature_c
 
 
+def product_start_c(problem: PlanProblem) -> float | None:
+    """The goods' temperature when a van under way sets off, if the start state says; None:
+    as loaded."""
+    state = problem.start_state
+    return None if state is None else state.product_temperature_c
+
+
 def path_tour(cost: NDArray[np.int64], effort: Effort, keep_order: bool) -> Tour:
     """The shortest path from the last place of ``cost`` (the van's position) through the
     stops to place 0 (the depot), as a tour of the places' indices from the start to the

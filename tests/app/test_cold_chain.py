@@ -1,0 +1,174 @@
+"""The cold chain through the API: a product class or band in cargo_box, the goods'
+temperature per stop beside the air's, and a verdict that agrees with its own numbers — held,
+or broken and answered (not refused) with the stop and the reason; bad products are 422s
+naming the field."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import pytest
+
+from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
+from tests.app.test_inputs import named, post_both_ways
+
+DYNAMIC = {"mode": "dynamic", "refrigeration_capacity_w": 3000.0}
+
+
+def plan(client, cargo_box: dict[str, Any]) -> dict[str, Any]:
+    answer = client.post("/v1/plans", json=PLAN_EXAMPLE | {"cargo_box": cargo_box})
+    assert answer.status_code == 200, answer.text[:500]
+    return answer.json()
+
+
+def check_agrees(answer: dict[str, Any]) -> dict[str, Any]:
+    """The verdict against the answer's own numbers: the band, the extremes, the stops."""
+    chain = answer["cold_chain"]
+    low, high = chain["product_min_c"], chain["product_max_c"]
+    inside = chain["min_c"] <= low and high <= chain["max_c"] + chain["excursion_c"]
+    assert chain["verdict"] == ("holds" if inside else "breaks")
+    assert (chain["reason"] is None) == inside
+    assert (chain["minutes_outside_band"] == 0) == (
+        chain["min_c"] <= low and high <= chain["max_c"]
+    )
+    for stop in answer["stops"]:
+        goods = stop["product_temperature_c"]
+        assert goods["arrival"] is not None  # the stop's goods are aboard on arrival
+        for value in goods.values():
+            assert value is None or low - 1e-9 <= value <= high + 1e-9
+    return chain
+
+
+def test_chilled_dairy_on_a_summer_day_holds_and_says_the_goods_temperature_per_stop(client):
+    answer = plan(client, DYNAMIC | {"product": "chilled-dairy", "load_temperature_c": 4.0})
+    chain = check_agrees(answer)
+    assert chain["verdict"] == "holds" and (chain["min_c"], chain["max_c"]) == (0.0, 6.0)
+    first = answer["stops"][0]
+    # the door warms the air (4.5 min open at 30 °C, a 3 kW unit) far more than the goods
+    air = first["air_temperature_c"]["departure"] - first["air_temperature_c"]["arrival"]
+    goods = first["product_temperature_c"]
+    assert air > 0.1 and abs(goods["departure"] - goods["arrival"]) < air / 5
+
+
+def test_goods_loaded_too_warm_break_the_chain_at_the_first_stop_and_are_answered(client):
+    # minced meat may be at most 2 °C: loaded at 2.5 °C it breaks from the start
+    answer = plan(client, DYNAMIC | {"product": "chilled-minced-meat", "load_temperature_c": 2.5})
+    chain = check_agrees(answer)
+    assert chain["verdict"] == "breaks"
+    assert chain["first_break_stop"] == answer["stops"][0]["id"]
+    assert (
+        chain["reason"].startswith("the goods reached 2.")
+        and "above their band's 2 °C" in (chain["reason"])
+    )
+
+
+def test_a_band_of_ones_own_and_a_frozen_day(client):
+    band = plan(client, DYNAMIC | {"product": {"min_c": -2.0, "max_c": 8.0, "excursion_c": 1.0}})
+    assert check_agrees(band)["verdict"] == "holds"
+    assert band["stops"][0]["product_temperature_c"]["arrival"] == pytest.approx(3.0, abs=0.1)
+    frozen = plan(client, DYNAMIC | {"product": "frozen", "refrigeration_capacity_w": 4000.0})
+    chain = check_agrees(frozen)
+    assert (chain["max_c"], chain["excursion_c"]) == (-18.0, 3.0)
+    assert frozen["stops"][0]["air_temperature_c"]["arrival"] == pytest.approx(-24.0, abs=0.5)
+
+
+def test_without_a_product_there_is_no_verdict_and_the_air_is_still_reported(client):
+    answer = plan(client, {})
+    assert answer["cold_chain"] is None
+    for stop in answer["stops"]:
+        assert stop["product_temperature_c"] is None
+        assert stop["air_temperature_c"]["arrival"] == pytest.approx(4.0)  # steady: set-point
+
+
+def test_each_van_of_a_fleet_carries_its_own_product(client):
+    body = copy.deepcopy(FLEET_PLAN_EXAMPLE)
+    body["vehicles"][0]["cargo_box"] = DYNAMIC | {"product": "chilled-poultry"}
+    answer = client.post("/v1/fleet-plans", json=body)
+    assert answer.status_code == 200, answer.text[:500]
+    routes = {route["vehicle_id"]: route for route in answer.json()["routes"]}
+    for vehicle_id, route in routes.items():
+        if vehicle_id == "van-1":
+            assert check_agrees(route)["max_c"] == 4.0
+        else:
+            assert route["cold_chain"] is None
+
+
+@pytest.mark.parametrize(
+    ("cargo_box", "field"),
+    [
+        ({"product": "chilled-fish"}, "cargo_box.product"),
+        ({"product": {"min_c": 5.0, "max_c": 1.0}}, "cargo_box.product.max_c"),
+        ({"product": {"min_c": 1e-320, "max_c": 1.0}}, "cargo_box.product.min_c"),
+        ({"product": "frozen", "setpoint_c": 2.0}, "cargo_box.setpoint_c"),
+        (
+            {"product": "chilled-dairy", "load_temperature_c": 5e-324},
+            "cargo_box.load_temperature_c",
+        ),
+        ({"product": "chilled-dairy", "load_temperature_c": 99.0}, "cargo_box.load_temperature_c"),
+    ],
+)
+def test_a_bad_product_is_a_422_naming_the_field(client, cargo_box, field):
+    body = PLAN_EXAMPLE | {"cargo_box": cargo_box}
+    assert post_both_ways(client, "/v1/plans", body)[0] == [field]
+    assert named(client.post("/v1/simulate", json=_simulate(cargo_box)), _simulate(cargo_box)) == [
+        field
+    ]
+
+
+def _simulate(cargo_box: dict[str, Any]) -> dict[str, Any]:
+    from app.examples import SIMULATE_EXAMPLE
+
+    return SIMULATE_EXAMPLE | {"cargo_box": cargo_box}
+
+
+def test_a_simulated_trace_carries_the_air_and_the_goods_and_their_verdict(client):
+    from app.examples import SIMULATE_EXAMPLE
+
+    body = SIMULATE_EXAMPLE | {
+        "cargo_box": DYNAMIC | {"product": "chilled-poultry", "load_temperature_c": 4.5},
+        "include_series": True,
+    }
+    answer = client.post("/v1/simulate", json=body)
+    assert answer.status_code == 200, answer.text[:500]
+    data = answer.json()
+    series, chain = data["series"], data["cold_chain"]
+    goods = series["product_temperature_c"]
+    assert len(goods) == len(series["time_s"]) == len(series["air_temperature_c"])
+    # loaded at 4.5 °C, above poultry's 4 °C: broken from the first step, said so
+    assert chain["verdict"] == "breaks" and chain["first_break_s"] == pytest.approx(
+        series["time_s"][1]
+    )
+    assert chain["product_max_c"] == pytest.approx(max(goods), abs=1e-9)
+    assert chain["product_min_c"] == pytest.approx(min(goods), abs=1e-9)
+    plain = client.post("/v1/simulate", json=SIMULATE_EXAMPLE | {"include_series": True}).json()
+    assert plain["cold_chain"] is None and plain["series"]["product_temperature_c"] is None
+
+
+def test_a_re_plan_carries_the_goods_temperature_the_van_reports(client):
+    state = {
+        "lat": 48.2006,
+        "lon": 16.3862,
+        "time": "2026-07-15T10:30:00+02:00",
+        "soc": 0.7,
+        "box_temperature_c": 3.0,
+        "product_temperature_c": 5.5,
+    }
+    body = PLAN_EXAMPLE | {
+        "cargo_box": DYNAMIC | {"product": "chilled-dairy"},
+        "start_state": state,
+        "stops": PLAN_EXAMPLE["stops"][1:],
+    }
+    answer = client.post("/v1/plans", json=body)
+    assert answer.status_code == 200, answer.text[:500]
+    data = answer.json()
+    # from 5.5 °C towards the air's 3 °C with a time constant of hours: still near 5.5
+    first = data["stops"][0]["product_temperature_c"]["arrival"]
+    assert 5.0 < first < 5.5
+    assert data["cold_chain"]["product_max_c"] == pytest.approx(5.5, abs=0.01)
+    without = client.post(
+        "/v1/plans", json=body | {"start_state": state | {"product_temperature_c": None}}
+    )
+    assert without.json()["stops"][0]["product_temperature_c"]["arrival"] == pytest.approx(
+        3.0, abs=0.05
+    )  # as loaded: the band's middle
