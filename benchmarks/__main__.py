@@ -2,6 +2,7 @@
 
 from benchmarks import (
     bench_calibration,
+    bench_cold_chain,
     bench_energy,
     bench_evrptw,
     bench_fleet,
@@ -19,6 +20,7 @@ for module in (
     bench_planner,
     bench_roads,
     bench_studies,
+    bench_cold_chain,
     bench_calibration,
     bench_fleet,
     bench_homberger,

@@ -8,7 +8,14 @@ from app import connectors
 from app.operations.answers import attribution, battery, box, energy, weather
 from app.operations.limits import check_round, search_limits
 from app.operations.vans import van_of
-from app.schemas.base import ColdChainOut, EnergySeries, EnergyShare, LineString, Point
+from app.schemas.base import (
+    ColdChainOut,
+    EnergySeries,
+    EnergyShare,
+    LineString,
+    Point,
+    RefrigerationOut,
+)
 from app.schemas.plans import (
     BreakOut,
     ChargeOut,
@@ -93,6 +100,9 @@ def plan_response(
             result.product_limit_c,
         ),
         cold_chain=None if result.cold_chain is None else ColdChainOut(**dict(result.cold_chain)),
+        refrigeration=(
+            None if result.refrigeration is None else RefrigerationOut(**dict(result.refrigeration))
+        ),
         solver=SolverOut(**dict(result.solved), objective=result.objective),
         distance_source=result.distance_source,
         warnings=result.warnings,

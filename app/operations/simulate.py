@@ -87,6 +87,11 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
             power_w=PowerSeries(**{k: [0.0, *p.tolist()] for k, p in result.power_w.items()}),
             soc=result.soc.tolist(),
             air_temperature_c=_at_samples(result.box.temperature_c),
+            air_setpoint_c=_at_samples(
+                np.full(result.box.temperature_c.shape, van.cargo_box.setpoint_c)
+                if result.box.setpoint_c is None
+                else result.box.setpoint_c
+            ),
             product_temperature_c=(
                 None if result.box.product_c is None else _at_samples(result.box.product_c)
             ),

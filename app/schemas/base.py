@@ -24,6 +24,7 @@ from core.params import (
     BatteryParams,
     CargoBoxParams,
     Params,
+    RefrigerationStrategy,
     VanParams,
     VehicleParams,
     few_unknown,
@@ -33,7 +34,7 @@ from core.params import (
 )
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import DayWeather, WeatherSource
-from core.planning.model import ColdChainResult
+from core.planning.model import ColdChainResult, RefrigerationResult
 from core.routing.geo import DistanceSource
 
 
@@ -179,6 +180,11 @@ class VanRequest(ApiModel):
     precondition_at_depot: Annotated[bool | None, NotNull] = absent(
         f"{VanParams.model_fields['precondition_at_depot'].description} Preset value if absent."
     )
+    refrigeration: Annotated[RefrigerationStrategy | None, NotNull] = absent(
+        'How the refrigeration unit is run through the day: {"strategy": "thermostat" | '
+        '"optimal", "objective": "energy", "precool_minutes": 60}. Preset value '
+        "(the thermostat) if absent."
+    )
 
     def profile(self) -> str | None:
         """The vehicle profile this van starts from (``vehicle.profile``), if any; a preset
@@ -233,7 +239,19 @@ class VanRequest(ApiModel):
             if self.precondition_at_depot is None
             else self.precondition_at_depot
         )
-        return VanParams(**built, payload_kg=payload, precondition_at_depot=precondition)
+        refrigeration = base.refrigeration if self.refrigeration is None else self.refrigeration
+        try:
+            with inside_validation():
+                return VanParams(
+                    **built,
+                    payload_kg=payload,
+                    precondition_at_depot=precondition,
+                    refrigeration=refrigeration,
+                )
+        except ValidationError as error:
+            rules = [(field_path(item["loc"]), item["msg"]) for item in error.errors()]
+            message = "; ".join(f"{field}: {rule}" for field, rule in rules)
+            raise InvalidParameterError(message, rules[0][0], rules) from None
 
 
 def _per_consumer(
@@ -375,6 +393,10 @@ class WeatherOut(ApiModel):
 
 class ColdChainOut(ApiModel, ColdChainResult):
     """Whether the goods stayed inside their band while aboard."""
+
+
+class RefrigerationOut(ApiModel, RefrigerationResult):
+    """How the refrigeration unit ran, and what it drew."""
 
 
 class BoxOut(ApiModel):

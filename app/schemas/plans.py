@@ -18,6 +18,7 @@ from app.schemas.base import (
     EnergyShare,
     LineString,
     Point,
+    RefrigerationOut,
     VanRequest,
     WeatherOut,
 )
@@ -162,6 +163,11 @@ class PlanResponse(ApiModel):
     weather: WeatherOut = Field(..., description="The weather the round was simulated with.")
     timezone: str = Field(..., description="Time zone of the times, or the solar-time note.")
     box: BoxOut = Field(..., description="Cargo-box temperatures (dynamic mode).")
+    refrigeration: RefrigerationOut | None = Field(
+        None,
+        description="How the refrigeration unit ran (refrigeration.strategy): its energy from "
+        "the battery and the grid, a thermostat's beside it, and its set-point schedule.",
+    )
     cold_chain: ColdChainOut | None = Field(
         None,
         description="Whether the goods stayed inside their product band while aboard "

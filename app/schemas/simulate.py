@@ -111,6 +111,11 @@ class Series(ApiModel):
         description="The box air at each sample [°C] (steady box: the set-point; the first "
         "sample's is the first step's).",
     )
+    air_setpoint_c: list[float] = Field(
+        default_factory=list,
+        description="The air set-point the unit followed at each sample [°C] (the optimal "
+        "strategy's schedule; else cargo_box.setpoint_c).",
+    )
     product_temperature_c: list[float | None] | None = Field(
         None,
         description="The goods at each sample [°C], null while none are aboard; null without "

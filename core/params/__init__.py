@@ -66,6 +66,7 @@ from core.params.van import (
     MIN_SOC_WINDOW,
     BatteryParams,
     CargoBoxParams,
+    RefrigerationStrategy,
     VanParams,
     VehicleParams,
 )
@@ -113,6 +114,7 @@ __all__ = [
     "Product",
     "ProductBand",
     "ProductClass",
+    "RefrigerationStrategy",
     "Result",
     "RoadMatrix",
     "Stop",

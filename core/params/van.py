@@ -482,6 +482,31 @@ class BatteryParams(Params):
         return value
 
 
+class RefrigerationStrategy(Params):
+    """How the refrigeration unit is run through the day."""
+
+    strategy: Literal["thermostat", "optimal"] = Field(
+        "thermostat",
+        description="'thermostat': the unit holds the air at its set-point. 'optimal': the air "
+        "set-point through the day that draws the least battery energy (or costs least) with "
+        "the goods inside their band at every moment, planned with the route (pre-cooling at "
+        "the depot on grid power, the air let float within the band, cooling while plugged "
+        "in), then simulated; needs cargo_box.product.",
+    )
+    objective: Literal["energy"] = Field(
+        "energy",
+        description="What the optimal strategy spares: 'energy', the battery's (the grid's, "
+        "while plugged in or before departure, counts a tenth).",
+    )
+    precool_minutes: float = Field(
+        60.0,
+        ge=0,
+        le=240,
+        description="Minutes plugged in at the depot before departure the optimal strategy may "
+        "cool the box and the goods on grid power (a van that leaves the depot).",
+    )
+
+
 class VanParams(Params):
     """Everything about the van that a simulation needs."""
 
@@ -502,3 +527,19 @@ class VanParams(Params):
         "leaves with the cab and the box structure at the outside temperature and the battery "
         "pays for the pull-down.",
     )
+    refrigeration: RefrigerationStrategy = Field(
+        default_factory=RefrigerationStrategy,
+        description="How the refrigeration unit is run: a thermostat, or the optimal schedule.",
+    )
+
+    @field_validator("refrigeration")
+    @classmethod
+    def _optimal_needs_a_band(
+        cls, value: RefrigerationStrategy, info: ValidationInfo
+    ) -> RefrigerationStrategy:
+        box = info.data.get("cargo_box")
+        if value.strategy == "optimal" and box is not None and box.product is None:
+            raise ValueError(
+                "strategy 'optimal' needs cargo_box.product: the band it keeps the goods in"
+            )
+        return value

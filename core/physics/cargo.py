@@ -17,7 +17,6 @@ from numpy.typing import ArrayLike
 
 from core.arrays import FloatArray
 from core.params import GRAVITY_MPS2, CargoBoxParams
-from core.physics.cold_chain import two_nodes
 
 #: Specific gas constant of dry air [J/(kg·K)].
 AIR_GAS_CONSTANT_J_KGK = 287.05
@@ -134,6 +133,17 @@ def door_conductance_w_k(box: CargoBoxParams, ambient_c: ArrayLike) -> FloatArra
     return np.where(usable, door_heat_w(box, ambient, box.setpoint_c) / safe, 0.0)
 
 
+def door_conductances_w_k(
+    box: CargoBoxParams, ambient_c: FloatArray, door_open: FloatArray
+) -> FloatArray:
+    """The open door's conductance in each step [W/K]: :func:`door_conductance_w_k` times the
+    share of the step it is open."""
+    conductance = np.zeros_like(ambient_c)
+    is_open = door_open > 0
+    conductance[is_open] = door_open[is_open] * door_conductance_w_k(box, ambient_c[is_open])
+    return conductance
+
+
 def precondition_energy_j(box: CargoBoxParams, ambient_c: float) -> float:
     """Electric energy to bring the box structure from the outside temperature to its
     set-point [J]: cooling over the COP, or heating over the heating COP (no heater: 0)."""
@@ -162,6 +172,15 @@ class BoxResult:
     product_c
         The goods' temperature at the end of each step [°C], NaN while none are aboard
         (:mod:`core.physics.cold_chain`); None: the box has no product.
+    setpoint_c
+        The air set-point of each step the unit followed [°C] (the optimal strategy's
+        schedule); None: ``setpoint_c`` throughout.
+    thermostat_power_w
+        With the optimal strategy: what a thermostat at ``setpoint_c`` would have drawn in
+        each step [W], for comparison.
+    precool_grid_j
+        Electric energy the optimal strategy spent cooling at the depot before departure,
+        from the grid [J].
     """
 
     power_w: FloatArray
@@ -172,6 +191,9 @@ class BoxResult:
     max_temperature_c: float
     minutes_above_limit: float
     product_c: FloatArray | None = None
+    setpoint_c: FloatArray | None = None
+    thermostat_power_w: FloatArray | None = None
+    precool_grid_j: float = 0.0
 
 
 #: Step of the dynamic box integration [s]: the box's time constant is many minutes even with
@@ -188,7 +210,6 @@ def refrigeration(
     payload_kg: ArrayLike,
     dt_s: float,
     initial_c: float | None = None,
-    product_start_c: float | None = None,
 ) -> BoxResult:
     """Heat loads and electric refrigeration power of every step (eqs 9–12).
 
@@ -209,9 +230,6 @@ def refrigeration(
     initial_c
         Temperature of the box structure and air at the start [°C] (the cargo is loaded at the
         set-point); None: everything at the set-point (pre-cooled at the depot).
-    product_start_c
-        With a product: the goods' temperature at the start [°C]; None: as loaded
-        (``load_temperature_c``).
 
     Notes
     -----
@@ -227,15 +245,7 @@ def refrigeration(
     the set-point. The state is the temperature, so unloading cargo changes only the heat
     capacity, never the temperature.
     """
-    door_conductance = np.zeros_like(ambient_c)
-    is_open = door_open > 0
-    door_conductance[is_open] = door_open[is_open] * door_conductance_w_k(box, ambient_c[is_open])
-    if box.product is not None:
-        air_c = box.setpoint_c if initial_c is None else initial_c
-        goods_c = box.load_c if product_start_c is None else product_start_c
-        return _with_goods(
-            box, (ambient_c, solar_heat, door_conductance), payload_kg, dt_s, (air_c, goods_c)
-        )
+    door_conductance = door_conductances_w_k(box, ambient_c, door_open)
     if box.mode == "steady":
         temperature, cooling, heating = _steady(
             box, ambient_c, solar_heat, door_conductance, dt_s, initial_c
@@ -261,43 +271,6 @@ def refrigeration(
         temperature_c=temperature,
         max_temperature_c=float(temperature.max()) if temperature.size else box.setpoint_c,
         minutes_above_limit=float(above.sum() * dt_s / 60.0),
-    )
-
-
-def _with_goods(
-    box: CargoBoxParams,
-    outside: tuple[FloatArray, FloatArray, FloatArray],
-    payload_kg: ArrayLike,
-    dt_s: float,
-    start_c: tuple[float, float],
-) -> BoxResult:
-    """The box of two nodes, air and goods (:mod:`core.physics.cold_chain`), its unit a
-    thermostat on the air at the set-point; ``outside``: the ambient [°C], the sun [W] and the
-    door's conductance [W/K] of each step; ``start_c``: the air's and the goods' [°C]."""
-    ambient_c, solar_heat, door_conductance = outside
-    conductance = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2 + door_conductance
-    nodes = two_nodes(
-        box,
-        air_heat_capacity_j_k(box),
-        conductance,
-        ambient_c + solar_heat / conductance,
-        np.broadcast_to(np.asarray(payload_kg, dtype=float), ambient_c.shape).astype(float),
-        np.full(ambient_c.shape, box.setpoint_c),
-        dt_s,
-        start_c,
-    )
-    air = nodes.air_c
-    cop = refrigeration_cop(box, ambient_c, air)
-    power = nodes.removed_w / cop + nodes.added_w / box.heating_cop + box.standby_power_w
-    return BoxResult(
-        power_w=power,
-        wall_heat_w=wall_heat_w(box, ambient_c, air),
-        solar_heat_w=solar_heat,
-        door_heat_w=door_conductance * (ambient_c - air),
-        temperature_c=air,
-        max_temperature_c=float(air.max()) if air.size else box.setpoint_c,
-        minutes_above_limit=float((air > box.product_limit_c).sum() * dt_s / 60.0),
-        product_c=nodes.product_c,
     )
 
 

@@ -22,19 +22,28 @@ follow the air slowly (hours), the air follows an open door in minutes. Two node
 The unit is an ideal thermostat on the air: each step it removes (or, with the heater, adds)
 what brings the air to its set-point at the step's end, within its capacity (unlimited in the
 paper's steady mode). Solved by backward Euler over steps of :data:`BOX_STEP_S` (the air's time
-constant is minutes even with the door open), in Numba.
+constant is minutes even with the door open), in Numba. The set-point is ``setpoint_c``, or
+with the optimal strategy the schedule :mod:`core.physics.strategy` plans for the day.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
 
 from core.arrays import FloatArray
-from core.params import CargoBoxParams, ProductBand
+from core.params import CargoBoxParams, ProductBand, RefrigerationStrategy
+from core.physics.cargo import (
+    BoxResult,
+    air_heat_capacity_j_k,
+    door_conductances_w_k,
+    refrigeration_cop,
+    wall_heat_w,
+)
+from core.physics.strategy import GRID_S, GRID_WEIGHT, BoxDay, optimal_schedule
 
 #: Step of the two-node integration [s].
 BOX_STEP_S = 10.0
@@ -66,7 +75,7 @@ def two_nodes(
     conductance_w_k: FloatArray,
     equilibrium_c: FloatArray,
     payload_kg: FloatArray,
-    setpoint_c: FloatArray,
+    setpoint_c: FloatArray | tuple[FloatArray, FloatArray],
     dt_s: float,
     start_c: tuple[float, float],
 ) -> TwoNodes:
@@ -84,7 +93,8 @@ def two_nodes(
     payload_kg
         The goods aboard in each step [kg].
     setpoint_c
-        The air set-point of each step [°C].
+        The air set-point of each step [°C]: the unit cools above it and heats below it; or
+        two, the unit cooling above the first and heating below the second.
     start_c
         The air's and the goods' temperatures at the start [°C].
     """
@@ -100,10 +110,11 @@ def two_nodes(
     cool_w = math.inf if steady else box.refrigeration_capacity_w
     heat_w = (math.inf if steady else box.heating_capacity_w) if box.heater_enabled else 0.0
     mass = mean(payload_kg)
+    cool_to, heat_to = setpoint_c if isinstance(setpoint_c, tuple) else (setpoint_c, setpoint_c)
     air, product, removed, added = _integrate(
         mean(conductance_w_k),
         mean(equilibrium_c),
-        mean(setpoint_c),
+        (mean(cool_to), mean(heat_to)),
         (air_capacity_j_k, mass * box.cargo_specific_heat_j_kgk),
         mass * box.product_conductance_w_kgk,
         counts * dt_s,
@@ -127,7 +138,7 @@ def two_nodes(
 def _integrate(
     g: FloatArray,
     eq: FloatArray,
-    setpoint: FloatArray,
+    setpoint: tuple[FloatArray, FloatArray],
     capacity: tuple[float, FloatArray],
     h: FloatArray,
     seconds: FloatArray,
@@ -136,7 +147,9 @@ def _integrate(
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Backward Euler over the blocks: the goods' equation solved for ``ϑ_p`` leaves the air's
     ``K·ϑ_a' = R − Q̇_0`` with ``K = C_a/Δt + G + k``, ``R = C_a/Δt·ϑ_a + G·ϑ_eq + k·ϑ_p`` and
-    ``k = (C_p/Δt)·H/(C_p/Δt + H)``; the unit's ``Q̇_0 = R − K·ϑ_set`` within its limits."""
+    ``k = (C_p/Δt)·H/(C_p/Δt + H)``; the unit's ``Q̇_0 = R − K·ϑ_set`` within its limits
+    (``setpoint``: the air it cools down to, and the air it heats up to)."""
+    cool_to, heat_to = setpoint
     c_air, c_product = capacity
     cool_w, heat_w = unit
     n = g.size
@@ -150,7 +163,9 @@ def _integrate(
         k = p * h[i] / both if both > 0 else 0.0
         big_k = a + g[i] + k
         r = a * ta + g[i] * eq[i] + k * tp
-        q = min(max(r - big_k * setpoint[i], -heat_w), cool_w)
+        q = min(r - big_k * cool_to[i], cool_w)
+        if q < 0:  # the air would end below the cooling set-point: heat only up to the other
+            q = max(min(r - big_k * heat_to[i], 0.0), -heat_w)
         ta = (r - q) / big_k
         if both > 0:
             tp = (p * tp + h[i] * ta) / both
@@ -160,6 +175,151 @@ def _integrate(
         else:
             added[i] = -q
     return air, product, removed, added
+
+
+@dataclass(frozen=True)
+class Run:
+    """How the unit runs: its strategy, the share of each step the van is plugged in (its
+    consumers on the grid), and whether it leaves the depot (the optimal strategy may pre-cool
+    there)."""
+
+    strategy: RefrigerationStrategy
+    plugged: FloatArray
+    from_depot: bool = True
+
+
+def box_with_goods(
+    box: CargoBoxParams,
+    outside: tuple[FloatArray, FloatArray, FloatArray],
+    payload_kg: FloatArray,
+    dt_s: float,
+    start_c: tuple[float, float],
+    run: Run,
+) -> BoxResult:
+    """The box of two nodes over steps of ``dt_s``: ``outside`` the ambient [°C], the sun [W]
+    and the door's open share of each step; the goods aboard [kg]; ``start_c`` the air's and
+    the goods' temperatures at the start [°C]; the unit a thermostat on the set-point, or on
+    the optimal strategy's schedule (pre-cooled at the depot from the grid)."""
+    ambient_c, solar_w, door_open = outside
+    door_w_k = door_conductances_w_k(box, ambient_c, door_open)
+    conductance = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2 + door_w_k
+    equilibrium = ambient_c + solar_w / conductance
+    air_capacity = air_heat_capacity_j_k(box)
+    flows = (conductance, equilibrium, payload_kg)
+    thermostat = np.full(ambient_c.shape, box.setpoint_c)
+    if run.strategy.strategy == "thermostat":
+        nodes = two_nodes(box, air_capacity, *flows, thermostat, dt_s, start_c)
+        return _result(box, ambient_c, solar_w, door_w_k, nodes, dt_s)
+    plugged = run.plugged
+    setpoint, departure_c, precool_j = _scheduled(
+        box, run, (ambient_c, *flows, plugged), dt_s, start_c
+    )
+    nodes = two_nodes(box, air_capacity, *flows, setpoint, dt_s, departure_c)
+    kept = two_nodes(box, air_capacity, *flows, thermostat, dt_s, start_c)
+    result = _result(box, ambient_c, solar_w, door_w_k, nodes, dt_s)
+    return replace(
+        result,
+        setpoint_c=setpoint[0],
+        thermostat_power_w=_result(box, ambient_c, solar_w, door_w_k, kept, dt_s).power_w,
+        precool_grid_j=precool_j,
+    )
+
+
+def _result(
+    box: CargoBoxParams,
+    ambient_c: FloatArray,
+    solar_w: FloatArray,
+    door_w_k: FloatArray,
+    nodes: TwoNodes,
+    dt_s: float,
+) -> BoxResult:
+    """The unit's power (eq. 12: the heat removed over the COP at the air's temperature, the
+    heater's, the standby draw) and the heat flows at the air's temperature."""
+    air = nodes.air_c
+    cop = refrigeration_cop(box, ambient_c, air)
+    power = nodes.removed_w / cop + nodes.added_w / box.heating_cop + box.standby_power_w
+    return BoxResult(
+        power_w=power,
+        wall_heat_w=wall_heat_w(box, ambient_c, air),
+        solar_heat_w=solar_w,
+        door_heat_w=door_w_k * (ambient_c - air),
+        temperature_c=air,
+        max_temperature_c=float(air.max()) if air.size else box.setpoint_c,
+        minutes_above_limit=float((air > box.product_limit_c).sum() * dt_s / 60.0),
+        product_c=nodes.product_c,
+    )
+
+
+def _scheduled(
+    box: CargoBoxParams,
+    run: Run,
+    inputs: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray],
+    dt_s: float,
+    start_c: tuple[float, float],
+) -> tuple[tuple[FloatArray, FloatArray], tuple[float, float], float]:
+    """The optimal strategy's set-points in each step (cool down to, heat up to) [°C], the air
+    and the goods at departure
+    [°C] and what pre-cooling drew from the grid [J]: the day on the programme's grid (its
+    steps' means), after the minutes at the depot it may pre-cool in."""
+    ambient, conductance, equilibrium, payload, plugged = inputs
+    n = ambient.size
+    per = max(round(GRID_S / dt_s), 1)
+    edges = np.arange(0, n, per)
+    counts = np.diff(np.append(edges, n))
+
+    def mean(values: FloatArray) -> FloatArray:
+        return np.add.reduceat(values, edges) / counts
+
+    outside = mean(ambient)
+    days = [
+        BoxDay(
+            seconds=counts * dt_s,
+            conductance_w_k=mean(conductance),
+            equilibrium_c=mean(equilibrium),
+            payload_kg=mean(payload),
+            cop=np.broadcast_to(refrigeration_cop(box, outside, box.setpoint_c), outside.shape),
+            weight=1.0 - (1.0 - GRID_WEIGHT) * mean(plugged),
+        )
+    ]
+    m = math.ceil(run.strategy.precool_minutes * 60.0 / GRID_S) if run.from_depot and n else 0
+    if m:  # at the depot, door shut, out of the sun, on the grid
+        wall = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
+        days.insert(0, _constant_day(m, wall, float(ambient[0]), float(payload[0]), box))
+        outside = np.concatenate([np.full(m, float(ambient[0])), outside])
+    day = BoxDay(
+        *(np.concatenate([getattr(d, f) for d in days]) for f in BoxDay.__dataclass_fields__)
+    )
+    assert box.band is not None  # the strategy needs a product (VanParams)
+    air_capacity = air_heat_capacity_j_k(box)
+    schedule = optimal_schedule(box, box.band, air_capacity, day, start_c)
+    departure = start_c
+    if m:
+        goods = float(schedule.product_c[m - 1])
+        departure = (float(schedule.air_c[m - 1]), goods if math.isfinite(goods) else start_c[1])
+    electric = (schedule.removed_w / day.cop + schedule.added_w / box.heating_cop) * day.seconds
+    # the air the programme keeps, from one minute's end to the next (a step up would have the
+    # heater chase it); the heater holds the floor, and the air where the programme heats
+    air = schedule.air_c[m:]
+    ends_s = np.cumsum(counts) * dt_s
+    cool_to = np.interp(
+        np.arange(1, n + 1) * dt_s, np.append(0.0, ends_s), np.append(departure[0], air)
+    )
+    heat_to = np.repeat(np.where(schedule.added_w[m:] > 0, air, box.band.min_c), counts)
+    return (cool_to, heat_to), departure, float(electric[:m].sum())
+
+
+def _constant_day(
+    m: int, conductance: float, ambient_c: float, payload_kg: float, box: CargoBoxParams
+) -> BoxDay:
+    """``m`` steps of the programme at the depot: the walls alone, the outside air, on the grid."""
+    return BoxDay(
+        seconds=np.full(m, GRID_S),
+        conductance_w_k=np.full(m, conductance),
+        equilibrium_c=np.full(m, ambient_c),
+        payload_kg=np.full(m, payload_kg),
+        cop=np.full(m, float(refrigeration_cop(box, ambient_c, box.setpoint_c))),
+        weight=np.full(m, GRID_WEIGHT),
+    )
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,7 @@ from core.physics import battery as battery_model
 from core.physics.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
 from core.physics.cargo import BoxResult, precondition_energy_j, refrigeration
 from core.physics.charging import WATTS_PER_KW, charge_curve
+from core.physics.cold_chain import Run, box_with_goods
 from core.physics.cycles import trace_distance_m
 from core.physics.motor import power_limited
 from core.physics.solar import (
@@ -103,6 +104,9 @@ class SimulationResult:
         For each sample, the moment of the trace asked for at the same place [s], when the
         motor's cap made the van drive it slower (:func:`core.physics.motor.power_limited`);
         None when it drove the trace as asked.
+    plugged
+        The share of each step plugged in at a charger [–] (the consumers on the grid),
+        ``n − 1`` values.
     """
 
     time_s: FloatArray
@@ -123,6 +127,7 @@ class SimulationResult:
     warnings: list[str]
     charges: list[ChargeOutcome] = field(default_factory=list)
     asked_s: FloatArray | None = None
+    plugged: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     def sample_at(self, asked_sample: ArrayLike) -> Any:
         """The sample that the van drove at the place of a sample of the trace asked for."""
@@ -283,7 +288,7 @@ def simulate(
     outside = _environment(start, location, van, weather, n - 1, dt_s)
     power, box, cab_gap_j = _consumers(van, trace, dt_s, outside, (box_start_c, product_start_c))
     departs_depot = van.precondition_at_depot and box_start_c is None
-    grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c)
+    grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c) + box.precool_grid_j
     return _result(
         trace,
         dt_s,
@@ -326,6 +331,7 @@ def _result(
         warnings=trace.warnings,
         charges=charges,
         asked_s=trace.asked_s,
+        plugged=plugged_share(trace.charging, n - 1, dt_s),
     )
 
 
@@ -416,20 +422,34 @@ def _consumers(
     box_start_c, product_start_c = start_c
     speed = trace.speed
     n_steps = speed.size - 1
-    box = refrigeration(
-        van.cargo_box,
-        outside.ambient_c,
-        outside.solar_heat_w,
-        door_open_fraction(trace.door_openings, np.arange(1, n_steps + 1) * dt_s, dt_s),
-        np.broadcast_to(trace.payload_step, outside.ambient_c.shape),
-        dt_s,
-        initial_c=(
-            box_start_c
-            if box_start_c is not None
-            else (None if van.precondition_at_depot else outside.start_c)
-        ),
-        product_start_c=product_start_c,
+    initial_c = (
+        box_start_c
+        if box_start_c is not None
+        else (None if van.precondition_at_depot else outside.start_c)
     )
+    door = door_open_fraction(trace.door_openings, np.arange(1, n_steps + 1) * dt_s, dt_s)
+    payload = np.broadcast_to(trace.payload_step, outside.ambient_c.shape).astype(float)
+    box_params = van.cargo_box
+    if box_params.product is None:
+        box = refrigeration(
+            box_params, outside.ambient_c, outside.solar_heat_w, door, payload, dt_s, initial_c
+        )
+    else:
+        box = box_with_goods(
+            box_params,
+            (outside.ambient_c, outside.solar_heat_w, door),
+            payload,
+            dt_s,
+            (
+                box_params.setpoint_c if initial_c is None else initial_c,
+                box_params.load_c if product_start_c is None else product_start_c,
+            ),
+            Run(
+                van.refrigeration,
+                plugged_share(trace.charging, n_steps, dt_s),
+                initial_c is None,
+            ),
+        )
     cab_gap_j = 0.0 if box_start_c is not None else _cab_gap_j(van, outside.start_c)
     power = {
         "traction": step_traction_power_w(
@@ -558,6 +578,16 @@ def _energy_kwh(power_w: dict[str, FloatArray], dt_s: float) -> dict[str, float]
             "cargo_box" if box else "vehicle",
         )
     return energy
+
+
+def plugged_share(charging: Sequence[ChargingSpell], n_steps: int, dt_s: float) -> FloatArray:
+    """Share of each step [–] plugged in at a charger."""
+    return interval_rates(
+        [c.start_s for c in charging],
+        [c.start_s + c.duration_s for c in charging],
+        n_steps,
+        dt_s,
+    )
 
 
 def door_open_fraction(

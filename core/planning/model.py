@@ -508,6 +508,43 @@ class ColdChainResult(Result):
         )
 
 
+class ScheduleInterval(Result):
+    """A stretch of the refrigeration unit's schedule."""
+
+    start: dt.datetime = Field(..., description="From, local time.")
+    end: dt.datetime = Field(..., description="Until, local time.")
+    power_w: float = Field(..., description="The unit's mean electric power [W].")
+    air_setpoint_c: float = Field(
+        ..., description="The air set-point the unit follows [°C] (its mean over the stretch)."
+    )
+
+
+class RefrigerationResult(Result):
+    """How the refrigeration unit ran, and what it drew."""
+
+    strategy: Literal["thermostat", "optimal"] = Field(
+        ..., description="The strategy the day was planned with (refrigeration.strategy)."
+    )
+    battery_kwh: float = Field(
+        ..., description="The unit's energy from the battery (unplugged) [kWh]."
+    )
+    grid_kwh: float = Field(
+        ...,
+        description="The unit's energy from the grid: while plugged in, and pre-cooling at the "
+        "depot before departure (optimal strategy) [kWh].",
+    )
+    thermostat_battery_kwh: float = Field(
+        ...,
+        description="What a thermostat at cargo_box.setpoint_c would have drawn from the "
+        "battery on the same day [kWh] (the thermostat strategy: battery_kwh).",
+    )
+    schedule: list[ScheduleInterval] = Field(
+        ...,
+        description="The unit's set-point and power, stretch by stretch (a set-point schedule "
+        "a unit's controller can load).",
+    )
+
+
 class StopResult(Result):
     """One stop of the round, in visiting order."""
 
@@ -704,6 +741,7 @@ class PlanResult:
     breaks: list[BreakResult] = field(default_factory=list)
     visits: list[VisitResult] = field(default_factory=list)
     cold_chain: ColdChainResult | None = None
+    refrigeration: RefrigerationResult | None = None
 
 
 UnassignedReason = Literal[

@@ -6,6 +6,7 @@ naming the field."""
 from __future__ import annotations
 
 import copy
+import itertools
 from typing import Any
 
 import pytest
@@ -172,3 +173,56 @@ def test_a_re_plan_carries_the_goods_temperature_the_van_reports(client):
     assert without.json()["stops"][0]["product_temperature_c"]["arrival"] == pytest.approx(
         3.0, abs=0.05
     )  # as loaded: the band's middle
+
+
+def test_the_optimal_strategy_spares_the_battery_and_says_its_schedule(client):
+    cargo = DYNAMIC | {"product": "chilled-dairy", "load_temperature_c": 4.0}
+    answers = {
+        strategy: client.post(
+            "/v1/plans",
+            json=PLAN_EXAMPLE | {"cargo_box": cargo, "refrigeration": {"strategy": strategy}},
+        ).json()
+        for strategy in ("thermostat", "optimal")
+    }
+    kept, planned = answers["thermostat"]["refrigeration"], answers["optimal"]["refrigeration"]
+    assert kept["strategy"] == "thermostat" and planned["strategy"] == "optimal"
+    assert kept["battery_kwh"] == pytest.approx(kept["thermostat_battery_kwh"])
+    assert kept["grid_kwh"] == 0.0 and {s["air_setpoint_c"] for s in kept["schedule"]} == {3.0}
+    # the same day's thermostat beside the optimum, which draws less from the battery and
+    # pre-cools on the grid
+    assert planned["thermostat_battery_kwh"] == pytest.approx(kept["battery_kwh"], rel=1e-9)
+    assert planned["battery_kwh"] < 0.9 * kept["battery_kwh"]
+    assert planned["grid_kwh"] > 0.0
+    for answer in answers.values():
+        assert check_agrees(answer)["verdict"] == "holds"
+        rf = answer["refrigeration"]
+        # no charge on this round: the unit's battery energy is the round's refrigeration
+        assert rf["battery_kwh"] == pytest.approx(answer["totals"]["energy_kwh"]["refrigeration"])
+        schedule = rf["schedule"]
+        assert schedule[0]["start"] == answer["legs"][0]["depart"]
+        assert schedule[-1]["end"] == answer["legs"][-1]["arrive"]
+        assert all(a["end"] == b["start"] for a, b in itertools.pairwise(schedule))
+    setpoints = [s["air_setpoint_c"] for s in planned["schedule"]]
+    assert 0.0 <= min(setpoints) < 3.0 < max(setpoints) <= 6.0  # floats within dairy's band
+    # the battery verdict rests on the strategy's energy
+    thermostat_soc = answers["thermostat"]["battery"]["min_soc"]
+    assert answers["optimal"]["battery"]["min_soc"] > thermostat_soc
+
+
+def test_the_optimal_strategy_needs_a_product_and_each_van_has_its_own(client):
+    body = PLAN_EXAMPLE | {"refrigeration": {"strategy": "optimal"}}
+    assert post_both_ways(client, "/v1/plans", body)[0] == ["refrigeration"]
+    bad = PLAN_EXAMPLE | {"refrigeration": {"strategy": "cheapest"}}
+    assert post_both_ways(client, "/v1/plans", bad)[0] == ["refrigeration.strategy"]
+    fleet = copy.deepcopy(FLEET_PLAN_EXAMPLE)
+    fleet["vehicles"][0] |= {
+        "cargo_box": DYNAMIC | {"product": "chilled-poultry"},
+        "refrigeration": {"strategy": "optimal"},
+    }
+    answer = client.post("/v1/fleet-plans", json=fleet)
+    assert answer.status_code == 200, answer.text[:500]
+    for route in answer.json()["routes"]:
+        strategy = route["refrigeration"]["strategy"]
+        assert strategy == ("optimal" if route["vehicle_id"] == "van-1" else "thermostat")
+    fleet["vehicles"][1]["refrigeration"] = {"strategy": "optimal"}  # van-2 has no product
+    assert post_both_ways(client, "/v1/fleet-plans", fleet)[0] == ["vehicles[1].refrigeration"]

@@ -9,19 +9,17 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from core.arrays import FloatArray
 from core.clock import at, check_representable
 from core.params import Location, Place
 from core.physics.battery import JOULES_PER_KWH
-from core.physics.cold_chain import check_cold_chain
 from core.physics.cycles import trace_distance_m
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate
+from core.planning.day.box import cold_chain, refrigeration, temperatures
 from core.planning.day.scene import Scene, charge_points
 from core.planning.day.start_state import box_start_c, product_start_c, start_payload_kg
 from core.planning.day.timeline import (
@@ -44,7 +42,6 @@ from core.planning.model import (
     ReloadResult,
     Solved,
     StopResult,
-    Temperatures,
     UnassignedReason,
     VisitKindName,
     VisitResult,
@@ -228,43 +225,25 @@ class _Split:
                     snap_distance_m=None if snap is None else float(snap[j]),
                     lat=places[j].lat,
                     lon=places[j].lon,
-                    air_temperature_c=self.temperatures(self.simulated.box.temperature_c, b, c),
+                    air_temperature_c=temperatures(self.simulated.box.temperature_c, b, c),
                     product_temperature_c=(
                         None
                         if self.simulated.box.product_c is None
-                        else self.temperatures(self.simulated.box.product_c, b, c)
+                        else temperatures(self.simulated.box.product_c, b, c)
                     ),
                 )
             )
         return out
 
-    @staticmethod
-    def temperatures(trace_c: FloatArray, b: int, c: int) -> Temperatures:
-        """A box trace (at each step's end) at samples ``b`` and ``c``: sample i ends step
-        i − 1; NaN (no goods aboard) is null."""
-
-        def at(sample: int) -> float | None:
-            value = float(trace_c[max(sample - 1, 0)]) if trace_c.size else math.nan
-            return value if math.isfinite(value) else None
-
-        return Temperatures(arrival=at(b), departure=at(c))
-
     def cold_chain(self) -> ColdChainResult | None:
         """The goods held to their band; the stop driven to or served when it first breaks."""
-        band, product_c = self.problem.van.cargo_box.band, self.simulated.box.product_c
-        if band is None or product_c is None:
-            return None
-        check = check_cold_chain(band, product_c, PLAN_DT_S)
-        stop = None
-        if check.first_break_step is not None:
-            sample = check.first_break_step + 1  # the step's end
-            stops = len(self.problem.stops)
-            for k, j in enumerate(self.order[1:-1]):
-                kind = self.itinerary.kind(k + 1, stops)
-                if kind == "stop" and int(self.timeline.leave[k]) >= sample:
-                    stop = self.scene.places[j].id
-                    break
-        return ColdChainResult.of(band, check, PLAN_DT_S, stop)
+        stops = len(self.problem.stops)
+        leaving = [
+            (int(self.timeline.leave[k]), self.scene.places[j].id)
+            for k, j in enumerate(self.order[1:-1])
+            if self.itinerary.kind(k + 1, stops) == "stop"
+        ]
+        return cold_chain(self.problem.van.cargo_box, self.simulated.box, leaving)
 
     def charges(self) -> list[ChargeResult]:
         """The charges between stops, with what the simulation made of them."""
@@ -398,6 +377,7 @@ class _Split:
             reloads=self.reloads(),
             visits=self.visits(),
             cold_chain=self.cold_chain(),
+            refrigeration=refrigeration(self.problem.van, simulated, self.moment),
             breaks=[
                 BreakResult(
                     start=self.moment(round(b.start_s)),

@@ -1,4 +1,4 @@
-"""The goods beside the box air (core/physics/cold_chain.py through cargo.refrigeration): the
+"""The goods beside the box air (core/physics/cold_chain.py, the unit a thermostat): the
 goods' equation against its analytic solution, goods delivered leaving with their heat, the
 energy balance of a steady box, a door heating the air fast and the goods slowly, a winter day
 with and without the heater, and the cold chain's verdict on traces worked by hand."""
@@ -10,19 +10,22 @@ import math
 import numpy as np
 import pytest
 
-from core.params import PRODUCT_CLASSES, CargoBoxParams, ProductBand
-from core.physics.cargo import refrigeration
-from core.physics.cold_chain import check_cold_chain
+from core.params import PRODUCT_CLASSES, CargoBoxParams, ProductBand, RefrigerationStrategy
+from core.physics.cold_chain import Run, box_with_goods, check_cold_chain
 
 HOUR = 3600
 DAIRY = CargoBoxParams(product="chilled-dairy", load_temperature_c=5.0)  # set-point 3 °C
 
 
 def run(box: CargoBoxParams, hours: float, ambient_c=30.0, payload=500.0, doors=None, sun=0.0):
+    """The box through ``hours`` of 1 s steps, its unit a thermostat, the air at its
+    set-point and the goods as loaded at the start."""
     n = int(hours * HOUR)
     door = np.zeros(n) if doors is None else doors
     mass = np.broadcast_to(np.asarray(payload, dtype=float), (n,)).astype(float)
-    return refrigeration(box, np.full(n, ambient_c), np.full(n, sun), door, mass, 1.0)
+    outside = (np.full(n, ambient_c), np.full(n, sun), door)
+    start = (box.setpoint_c, box.load_c)
+    return box_with_goods(box, outside, mass, 1.0, start, Run(RefrigerationStrategy(), np.zeros(n)))
 
 
 def test_the_goods_follow_the_air_with_their_own_time_constant():
