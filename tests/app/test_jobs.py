@@ -294,7 +294,7 @@ def test_cancel_a_queued_and_a_running_job(server):
 
 
 def test_a_worker_killed_mid_job_runs_it_again(server):
-    job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 4)}).json()["id"]
+    job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 10)}).json()["id"]
     wait_for(server.url, job_id, states=("running",))
     time.sleep(0.5)
     solving = busiest_child(server.process.pid)

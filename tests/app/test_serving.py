@@ -69,7 +69,7 @@ def test_liveness_answers_while_every_worker_solves(server):
 )
 def test_a_full_queue_and_a_long_wait_are_503_with_retry_after(server):
     with concurrent.futures.ThreadPoolExecutor(3) as pool:
-        busy = pool.submit(post, server.url, long_plan(300, 5))
+        busy = pool.submit(post, server.url, long_plan(300, 12))
         wait_until(server.url, "1 busy")
         queued = pool.submit(post, server.url, long_plan(8, 0.1))
         wait_until(server.url, "1 waiting")
@@ -88,7 +88,7 @@ def test_a_full_queue_and_a_long_wait_are_503_with_retry_after(server):
 @pytest.mark.parametrize("server", [{"COLDROUTE_WORKERS": "1"}], indirect=True)
 def test_a_client_that_goes_away_gives_up_its_place(server):
     with concurrent.futures.ThreadPoolExecutor(1) as pool:
-        busy = pool.submit(post, server.url, long_plan(300, 4))
+        busy = pool.submit(post, server.url, long_plan(300, 10))
         time.sleep(1.0)
         with pytest.raises(httpx.ReadTimeout):
             post(server.url, long_plan(8, 0.1), timeout=0.5)
