@@ -394,15 +394,21 @@ def _given_to_idle(
     day: FleetDay, rules: Feasibility, routes: list[list[int]], results: dict[int, PlanResult]
 ) -> dict[int, Failure]:
     """Each stop left out that a van without a route serves on a round of its own goes to
-    that van (``routes`` and ``results`` changed in place): first by the estimates, then by
-    the simulation. No stop stays out for a window or the fleet's being full while an idle
-    van could take it; where the simulation refuses the round of its own, its failure is why
-    (returned by stop). One simulation per stop and kind of idle van."""
+    that van, or joins a round given to an idle van here where it holds (a few stops the
+    charging verification took out make one round, not a van each); ``routes`` and
+    ``results`` change in place. First by the estimates, then by the simulation. No stop
+    stays out for a window or the fleet's being full while an idle van could take it; where
+    the simulation refuses the round of its own, its failure is why (returned by stop). One
+    simulation per stop and kind of idle van, and one per round it may join."""
     kinds = [_kind(day, v) for v in day.vans]
     served = {node for route in routes for node in route}
     refused: dict[int, Failure] = {}
+    given: list[int] = []  # the idle vans given stops here: the next stop joins one if it can
     for node in day.stop_nodes:
         if node in served or node in day.unreachable:
+            continue
+        if any(_joined(day, v, node, routes, results) for v in given):
+            refused.pop(node, None)
             continue
         tried: set[str] = set()
         for v in day.vans:
@@ -413,10 +419,32 @@ def _given_to_idle(
             failure = _failure(day, v, result)
             if failure is None:
                 routes[v], results[v] = [node], result
+                given.append(v)
                 refused.pop(node, None)
                 break
             refused[node] = replace(failure, node=node)
     return refused
+
+
+def _joined(
+    day: FleetDay, v: int, node: int, routes: list[list[int]], results: dict[int, PlanResult]
+) -> bool:
+    """``node`` added to van ``v``'s route where it lengthens the driving least (by the
+    matrix's times), kept when the simulation holds (``routes`` and ``results`` changed in
+    place)."""
+    order = day.order(v, routes[v])
+    times = day.duration_s
+    added = [
+        times[order[k], node] + times[node, order[k + 1]] - times[order[k], order[k + 1]]
+        for k in range(len(order) - 1)
+    ]
+    k = int(np.argmin(added))
+    route = [*routes[v][:k], node, *routes[v][k:]]
+    result = day.simulate(v, route)
+    if _failure(day, v, result) is not None:
+        return False
+    routes[v], results[v] = route, result
+    return True
 
 
 def _kind(day: FleetDay, v: int) -> str:

@@ -23,8 +23,9 @@ from core.planning.charging.fleet_charging import (
 )
 from core.planning.day.timeline import MAX_DRIVING_S
 from core.planning.day.verify import Failure
-from core.planning.fleet.planner import plan_fleet
+from core.planning.fleet.planner import _failure, _given_to_idle, plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
+from core.planning.search.feasibility import Feasibility
 from tests.core.planning.test_breaks import driving_between_breaks_s
 from tests.core.planning.test_recharge import summer_day
 from tests.utils.fleets import DEPOT
@@ -257,3 +258,20 @@ def test_the_search_knows_each_chargers_points_and_opening_hours():
     assert charging.instance.closed == {
         on_way: [(-math.inf, 2 * h), (4 * h, 6 * h), (8 * h, math.inf)]
     }
+
+
+def test_stops_left_out_share_one_idle_van_where_its_round_holds():
+    """Two stops of the east cluster left out beside a route of the rest: the first goes
+    to an idle van, the second joins its round (a van each would be a van more for nothing);
+    the third van stays idle."""
+    stops, matrix = clusters()
+    problem = cluster_fleet(stops, [cluster_van(f"van-{k}") for k in range(3)], matrix=matrix)
+    day = cluster_day(problem)
+    routes: list[list[int]] = [[4, 5, 6, 2], [], []]  # the west cluster and one of the east
+    results = {0: day.simulate(0, routes[0])}
+    budgets = [day.estimates[v].budget_j for v in day.vans]
+    rules = Feasibility(day, day.duration_s.astype(np.int64), budgets)
+    refused = _given_to_idle(day, rules, routes, results)  # 1 and 3 are left out
+    assert not refused
+    assert sorted(routes[1]) == [1, 3] and routes[2] == []
+    assert _failure(day, 1, results[1]) is None  # its simulation holds
