@@ -9,7 +9,8 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    taught the search) and, per kind of van, its energy (traction by the arc's grade for the
    van's mass, the standing loads by its duration, each stop's service and door openings at
    its origin: :mod:`core.planning.day.estimates`); each van kind's battery between its reserve
-   and full, what it holds at departure, its payload, its shift and where it sets off; each
+   and full, what it holds at departure, its payload, its shift (its latest return less the
+   driver's breaks the shift holds) and where it sets off; each
    charger's charge time per joule (the van's charging curve at the charger's power, reserve
    to 80 %), its plug-in time, its points when fewer than the vans (the search shares them
    out) and when it is closed (outside its opening hours); each stop's window (the first
@@ -45,10 +46,10 @@ from core.planning.day.estimates import cost_matrix, energy_matrix_j
 from core.planning.day.recharge import Busy
 from core.planning.day.scene import charge_points
 from core.planning.day.start_state import start_payload_kg
-from core.planning.day.timeline import seconds_after
+from core.planning.day.timeline import EU_BREAK_S, MAX_DRIVING_S, seconds_after
 from core.planning.day.verify import Failure, route_failure
 from core.planning.itinerary import ChargeVisit, Itinerary
-from core.planning.model import DEPOT_CHARGER_ID, PlanResult
+from core.planning.model import DEPOT_CHARGER_ID, PlanProblem, PlanResult
 from core.planning.search.day import FleetDay, long_where_no_road
 from core.planning.search.repair import Repaired, repair
 from core.routing.effort import Effort, SearchEnd, combined
@@ -204,6 +205,18 @@ def _closed_s(day: FleetDay, point: ChargePoint) -> list[Span]:
     )
 
 
+def _breaks_s(problem: PlanProblem, shift_s: tuple[float, float]) -> float:
+    """The driver's breaks a shift of ``shift_s`` holds [s], kept off the search's latest
+    return (the search does not place them; the simulation does, and a route that comes
+    back late for them loses stops): under EU 561 a 45-minute break for every 4 h 30 of
+    driving the shift leaves room for, fixed breaks as given."""
+    if isinstance(problem.breaks, list):
+        return sum(rest.minutes for rest in problem.breaks) * 60.0
+    if problem.breaks != "eu-561":
+        return 0.0
+    return math.floor((shift_s[1] - shift_s[0]) / (MAX_DRIVING_S + EU_BREAK_S)) * EU_BREAK_S
+
+
 def _reloads(day: FleetDay, v: int) -> bool:
     return day.shifts[v].problem.max_trips > 1
 
@@ -255,7 +268,7 @@ def _kinds(
                 capacity=float(payload_units_down(problem.van.payload_kg)),
                 start=day.starts[v],
                 ready=day.shift_s[v][0],
-                due=day.shift_s[v][1],
+                due=day.shift_s[v][1] - _breaks_s(problem, day.shift_s[v]),
                 aboard=float(payload_units_down(start_payload_kg(problem))),
                 reload=reload,
                 max_trips=problem.max_trips,

@@ -275,3 +275,23 @@ def test_stops_left_out_share_one_idle_van_where_its_round_holds():
     assert not refused
     assert sorted(routes[1]) == [1, 3] and routes[2] == []
     assert _failure(day, 1, results[1]) is None  # its simulation holds
+
+
+@pytest.mark.parametrize(
+    ("breaks", "kept_off_s"),
+    [
+        ("eu-561", 45 * 60.0),  # a 9 h shift: room for one 4 h 30 of driving and its break
+        ("none", 0.0),
+        ([{"earliest": "11:00", "latest": "13:00", "minutes": 30}], 30 * 60.0),
+    ],
+)
+def test_the_search_keeps_the_drivers_breaks_off_its_latest_return(breaks, kept_off_s):
+    """The search does not place breaks (the simulation does): a route it plans to the end of
+    the shift would come back late for them, so its latest return leaves them room."""
+    stops, matrix = clusters()
+    van = FleetVehicle.model_validate(cluster_van("a").model_dump() | {"breaks": breaks})
+    problem = cluster_fleet(stops, [van], matrix=matrix)
+    day = cluster_day(problem)
+    (kind,) = charging_instance(day, day.duration_s, True).instance.kinds
+    assert kind.due == pytest.approx(day.shift_s[0][1] - kept_off_s)
+    assert day.shift_s[0][1] - day.shift_s[0][0] == 9 * 3600.0
