@@ -41,36 +41,47 @@ def test_every_phase_and_check_passes():
         }
     ).start()
     try:
-        run = subprocess.run(
-            [
-                *SCHEMATHESIS,
-                "run",
-                f"{server.url}/openapi.json",
-                "--phases",
-                "examples,coverage,fuzzing,stateful",
-                "--checks",
-                "all",
-                # DELETE /v1/jobs/{id} cancels and keeps the job readable ("cancelled"), as the
-                # jobs API promises; "a deleted resource is gone" does not apply to it.
-                "--exclude-checks",
-                "use_after_free",
-                "--max-examples",
-                os.environ.get("COLDROUTE_CONTRACT_EXAMPLES", "10"),
-                "--header",
-                f"X-API-Key: {KEY}",
-                "--generation-deterministic",
-                "--request-timeout",
-                "60",
-                "--workers",
-                "2",
-                "--no-color",
-            ],
-            cwd=ROOT,  # schemathesis.toml
-            capture_output=True,
-            text=True,
-            timeout=540,
-        )
+        run = _schemathesis(server)
+        if run.returncode and CPYTHON_AST_BUG in run.stdout + run.stderr:
+            run = _schemathesis(server)  # the tool's own failure (above): once more
         log = server.log_path.read_text()
     finally:
         server.close()
     assert run.returncode == 0, run.stdout[-20_000:] + run.stderr[-2_000:] + log[-5_000:]
+
+
+#: How CPython 3.11's AST depth counter (gh-106905) fails inside Schemathesis: seen once in
+#: several full runs with two Schemathesis workers, never in the service's answers.
+CPYTHON_AST_BUG = "AST constructor recursion depth mismatch"
+
+
+def _schemathesis(server: Server) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [
+            *SCHEMATHESIS,
+            "run",
+            f"{server.url}/openapi.json",
+            "--phases",
+            "examples,coverage,fuzzing,stateful",
+            "--checks",
+            "all",
+            # DELETE /v1/jobs/{id} cancels and keeps the job readable ("cancelled"), as the
+            # jobs API promises; "a deleted resource is gone" does not apply to it.
+            "--exclude-checks",
+            "use_after_free",
+            "--max-examples",
+            os.environ.get("COLDROUTE_CONTRACT_EXAMPLES", "10"),
+            "--header",
+            f"X-API-Key: {KEY}",
+            "--generation-deterministic",
+            "--request-timeout",
+            "60",
+            "--workers",
+            "2",
+            "--no-color",
+        ],
+        cwd=ROOT,  # schemathesis.toml
+        capture_output=True,
+        text=True,
+        timeout=540,
+    )
