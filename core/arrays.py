@@ -114,3 +114,18 @@ def uniform_interp(values: ArrayLike, per_interval: int, n: int) -> FloatArray:
     if filled.size >= n:
         return filled[:n]
     return np.concatenate((filled, np.full(n - filled.size, coarse[-1])))
+
+
+class Blocks:
+    """``n`` steps in consecutive blocks of ``per_block`` (the last may be shorter): where each
+    begins, how many steps each holds, and a quantity's mean over each."""
+
+    def __init__(self, n: int, per_block: int) -> None:
+        self.edges = np.arange(0, n, max(per_block, 1))
+        self.counts = np.diff(np.append(self.edges, n))
+
+    def mean(self, values: ArrayLike) -> FloatArray:
+        """Each block's mean of ``values`` (one per step)."""
+        if not self.edges.size:
+            return np.zeros(0)
+        return np.add.reduceat(np.asarray(values, dtype=float), self.edges) / self.counts

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core.arrays import FloatArray
+from core.arrays import Blocks, FloatArray
 from core.params import GRAVITY_MPS2, CargoBoxParams
 
 #: Specific gas constant of dry air [J/(kg·K)].
@@ -320,12 +320,8 @@ def _integrate_box(
     the unit's capacity, a warm start, a cold drift without heater).
     """
     n = ambient_c.size
-    per_block = max(round(BOX_STEP_S / dt_s), 1)
-    edges = np.arange(0, n, per_block)
-    counts = np.diff(np.append(edges, n))
-
-    def block_mean(values: FloatArray) -> FloatArray:
-        return np.add.reduceat(values, edges) / counts if n else np.zeros(0)
+    blocks = Blocks(n, round(BOX_STEP_S / dt_s))
+    edges, counts, block_mean = blocks.edges, blocks.counts, blocks.mean
 
     wall_g = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
     conductance = wall_g + block_mean(door_conductance)

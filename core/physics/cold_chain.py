@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numba import njit
 
-from core.arrays import FloatArray
+from core.arrays import Blocks, FloatArray
 from core.params import CargoBoxParams, ProductBand, RefrigerationStrategy
 from core.physics.cargo import (
     BoxResult,
@@ -99,12 +99,8 @@ def two_nodes(
         The air's and the goods' temperatures at the start [°C].
     """
     n = conductance_w_k.size
-    per_block = max(round(BOX_STEP_S / dt_s), 1)
-    edges = np.arange(0, n, per_block)
-    counts = np.diff(np.append(edges, n))
-
-    def mean(values: FloatArray) -> FloatArray:
-        return np.add.reduceat(values, edges) / counts if n else np.zeros(0)
+    blocks = Blocks(n, round(BOX_STEP_S / dt_s))
+    edges, counts, mean = blocks.edges, blocks.counts, blocks.mean
 
     steady = box.mode == "steady"
     cool_w = math.inf if steady else box.refrigeration_capacity_w
@@ -263,12 +259,8 @@ def _scheduled(
     steps' means), after the minutes at the depot it may pre-cool in."""
     ambient, conductance, equilibrium, payload, plugged = inputs
     n = ambient.size
-    per = max(round(GRID_S / dt_s), 1)
-    edges = np.arange(0, n, per)
-    counts = np.diff(np.append(edges, n))
-
-    def mean(values: FloatArray) -> FloatArray:
-        return np.add.reduceat(values, edges) / counts
+    blocks = Blocks(n, round(GRID_S / dt_s))
+    counts, mean = blocks.counts, blocks.mean
 
     outside = mean(ambient)
     days = [
