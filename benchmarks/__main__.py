@@ -3,6 +3,7 @@
 from benchmarks import (
     bench_calibration,
     bench_cold_chain,
+    bench_cold_chain_robust,
     bench_energy,
     bench_evrptw,
     bench_fleet,
@@ -15,18 +16,21 @@ from benchmarks import (
     evrptw,
 )
 
-for module in (
-    bench_energy,
-    bench_planner,
-    bench_roads,
-    bench_studies,
-    bench_cold_chain,
-    bench_calibration,
-    bench_fleet,
-    bench_homberger,
-    evrptw,
-    bench_evrptw,
-    bench_serving,
-    bench_soak,
-):
-    module.main()
+# the replays' worker processes import this module again: only the parent runs the benchmarks
+if __name__ == "__main__":
+    for module in (
+        bench_energy,
+        bench_planner,
+        bench_roads,
+        bench_studies,
+        bench_cold_chain,
+        bench_cold_chain_robust,
+        bench_calibration,
+        bench_fleet,
+        bench_homberger,
+        evrptw,
+        bench_evrptw,
+        bench_serving,
+        bench_soak,
+    ):
+        module.main()

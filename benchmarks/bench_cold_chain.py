@@ -86,17 +86,24 @@ def rows_of(name: str, body: dict[str, Any]) -> list[list[object]]:
     return rows
 
 
+def test_days() -> list[tuple[str, dict[str, Any]]]:
+    """The reference summer day, a frozen one and a winter one, by name."""
+    return [
+        ("summer, chilled dairy", reference_day()),
+        (
+            "summer, frozen",
+            reference_day(cargo_box={"product": "frozen", "load_temperature_c": -22.0}),
+        ),
+        (
+            "winter, chilled dairy",
+            reference_day(date="2026-01-15", weather={"t_min_c": -12, "t_max_c": -4}),
+        ),
+    ]
+
+
 def main() -> None:
-    reference = reference_day()
-    frozen = reference_day(
-        cargo_box={"product": "frozen", "load_temperature_c": -22.0},
-        weather={"t_min_c": 20, "t_max_c": 30},
-    )
-    winter = reference_day(
-        date="2026-01-15",
-        weather={"t_min_c": -12, "t_max_c": -4},
-        cargo_box={"product": "chilled-dairy", "load_temperature_c": 4.0},
-    )
+    days = test_days()
+    reference = days[0][1]
     thermostat, _ = planned(reference, "thermostat")
     optimal, _ = planned(reference, "optimal")
     # a battery between what the two draw: the thermostat runs it below its reserve
@@ -113,10 +120,9 @@ def main() -> None:
         }
     )
     rows = [
-        *rows_of("summer, chilled dairy", reference),
-        *rows_of("summer, frozen", frozen),
-        *rows_of("winter, chilled dairy", winter),
-        *rows_of("summer, a tight battery", tight),
+        row
+        for name, body in [*days, ("summer, a tight battery", tight)]
+        for row in rows_of(name, body)
     ]
     print_table(
         "Refrigeration strategy on planned days (run_plan, 30 stops, ev-van-3.5t-reefer)",

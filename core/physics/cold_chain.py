@@ -184,9 +184,26 @@ class Run:
     from_depot: bool = True
 
 
+#: The box's surroundings over a trace, per step: the ambient [°C], the sun on the box [W] and
+#: the door's open share [–].
+Outside = tuple[FloatArray, FloatArray, FloatArray]
+
+
+@dataclass(frozen=True)
+class Setpoints:
+    """What the unit follows through a trace, per step: the air it cools down to and the air
+    it heats up to [°C]; with the air and the goods at departure [°C] after pre-cooling at the
+    depot, and what that drew from the grid [J]."""
+
+    cool_to_c: FloatArray
+    heat_to_c: FloatArray
+    departure_c: tuple[float, float]
+    precool_grid_j: float = 0.0
+
+
 def box_with_goods(
     box: CargoBoxParams,
-    outside: tuple[FloatArray, FloatArray, FloatArray],
+    outside: Outside,
     payload_kg: FloatArray,
     dt_s: float,
     start_c: tuple[float, float],
@@ -196,29 +213,49 @@ def box_with_goods(
     and the door's open share of each step; the goods aboard [kg]; ``start_c`` the air's and
     the goods' temperatures at the start [°C]; the unit a thermostat on the set-point, or on
     the optimal strategy's schedule (pre-cooled at the depot from the grid)."""
+    thermostat = Setpoints(*(np.full(payload_kg.shape, box.setpoint_c),) * 2, start_c)
+    kept = follow(box, outside, payload_kg, dt_s, thermostat)
+    if run.strategy.strategy == "thermostat":
+        return kept
+    planned = plan_setpoints(box, outside, payload_kg, dt_s, start_c, run)
+    return replace(
+        follow(box, outside, payload_kg, dt_s, planned),
+        setpoint_c=planned.cool_to_c,
+        thermostat_power_w=kept.power_w,
+        precool_grid_j=planned.precool_grid_j,
+    )
+
+
+def _flows(box: CargoBoxParams, outside: Outside) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The door's conductance, the box's in all [W/K] and its equilibrium [°C] (eqs 10, 11,
+    17) in each step."""
     ambient_c, solar_w, door_open = outside
     door_w_k = door_conductances_w_k(box, ambient_c, door_open)
     conductance = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2 + door_w_k
-    equilibrium = ambient_c + solar_w / conductance
-    air_capacity = air_heat_capacity_j_k(box)
-    flows = (conductance, equilibrium, payload_kg)
-    thermostat = np.full(ambient_c.shape, box.setpoint_c)
-    if run.strategy.strategy == "thermostat":
-        nodes = two_nodes(box, air_capacity, *flows, thermostat, dt_s, start_c)
-        return _result(box, ambient_c, solar_w, door_w_k, nodes, dt_s)
-    plugged = run.plugged
-    setpoint, departure_c, precool_j = _scheduled(
-        box, run, (ambient_c, *flows, plugged), dt_s, start_c
+    return door_w_k, conductance, ambient_c + solar_w / conductance
+
+
+def follow(
+    box: CargoBoxParams,
+    outside: Outside,
+    payload_kg: FloatArray,
+    dt_s: float,
+    setpoints: Setpoints,
+) -> BoxResult:
+    """The box with its unit following ``setpoints`` from their departure temperatures (the
+    arguments as :func:`box_with_goods`')."""
+    door_w_k, conductance, equilibrium = _flows(box, outside)
+    nodes = two_nodes(
+        box,
+        air_heat_capacity_j_k(box),
+        conductance,
+        equilibrium,
+        payload_kg,
+        (setpoints.cool_to_c, setpoints.heat_to_c),
+        dt_s,
+        setpoints.departure_c,
     )
-    nodes = two_nodes(box, air_capacity, *flows, setpoint, dt_s, departure_c)
-    kept = two_nodes(box, air_capacity, *flows, thermostat, dt_s, start_c)
-    result = _result(box, ambient_c, solar_w, door_w_k, nodes, dt_s)
-    return replace(
-        result,
-        setpoint_c=setpoint[0],
-        thermostat_power_w=_result(box, ambient_c, solar_w, door_w_k, kept, dt_s).power_w,
-        precool_grid_j=precool_j,
-    )
+    return _result(box, outside[0], outside[1], door_w_k, nodes, dt_s)
 
 
 def _result(
@@ -246,44 +283,49 @@ def _result(
     )
 
 
-def _scheduled(
+def plan_setpoints(
     box: CargoBoxParams,
-    run: Run,
-    inputs: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray],
+    outside: Outside,
+    payload_kg: FloatArray,
     dt_s: float,
     start_c: tuple[float, float],
-) -> tuple[tuple[FloatArray, FloatArray], tuple[float, float], float]:
-    """The optimal strategy's set-points in each step (cool down to, heat up to) [°C], the air
-    and the goods at departure
-    [°C] and what pre-cooling drew from the grid [J]: the day on the programme's grid (its
-    steps' means), after the minutes at the depot it may pre-cool in."""
-    ambient, conductance, equilibrium, payload, plugged = inputs
+    run: Run,
+    grid_s: float = GRID_S,
+) -> Setpoints:
+    """The optimal strategy's set-points for the day ahead (the arguments as
+    :func:`box_with_goods`'): the day on the programme's grid of ``grid_s`` [s] (its steps'
+    means), after the minutes at the depot it may pre-cool in. From a start under way
+    (``run.from_depot`` false) it is the receding horizon's re-plan: the rest of the day from
+    the box's state."""
+    ambient = outside[0]
+    _, conductance, equilibrium = _flows(box, outside)
     n = ambient.size
-    blocks = Blocks(n, round(GRID_S / dt_s))
+    blocks = Blocks(n, max(round(grid_s / dt_s), 1))
     counts, mean = blocks.counts, blocks.mean
-
-    outside = mean(ambient)
+    grid_outside = mean(ambient)
     days = [
         BoxDay(
             seconds=counts * dt_s,
             conductance_w_k=mean(conductance),
             equilibrium_c=mean(equilibrium),
-            payload_kg=mean(payload),
-            cop=np.broadcast_to(refrigeration_cop(box, outside, box.setpoint_c), outside.shape),
-            weight=1.0 - (1.0 - GRID_WEIGHT) * mean(plugged),
+            payload_kg=mean(payload_kg),
+            cop=np.broadcast_to(
+                refrigeration_cop(box, grid_outside, box.setpoint_c), grid_outside.shape
+            ),
+            weight=1.0 - (1.0 - GRID_WEIGHT) * mean(run.plugged),
         )
     ]
-    m = math.ceil(run.strategy.precool_minutes * 60.0 / GRID_S) if run.from_depot and n else 0
+    m = math.ceil(run.strategy.precool_minutes * 60.0 / grid_s) if run.from_depot and n else 0
     if m:  # at the depot, door shut, out of the sun, on the grid
         wall = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
-        days.insert(0, _constant_day(m, wall, float(ambient[0]), float(payload[0]), box))
-        outside = np.concatenate([np.full(m, float(ambient[0])), outside])
+        days.insert(
+            0, _constant_day(m, grid_s, wall, (float(ambient[0]), float(payload_kg[0])), box)
+        )
     day = BoxDay(
         *(np.concatenate([getattr(d, f) for d in days]) for f in BoxDay.__dataclass_fields__)
     )
     assert box.band is not None  # the strategy needs a product (VanParams)
-    air_capacity = air_heat_capacity_j_k(box)
-    schedule = optimal_schedule(box, box.band, air_capacity, day, start_c)
+    schedule = optimal_schedule(box, box.band, air_heat_capacity_j_k(box), day, start_c)
     departure = start_c
     if m:
         goods = float(schedule.product_c[m - 1])
@@ -297,15 +339,17 @@ def _scheduled(
         np.arange(1, n + 1) * dt_s, np.append(0.0, ends_s), np.append(departure[0], air)
     )
     heat_to = np.repeat(np.where(schedule.added_w[m:] > 0, air, box.band.min_c), counts)
-    return (cool_to, heat_to), departure, float(electric[:m].sum())
+    return Setpoints(cool_to, heat_to, departure, float(electric[:m].sum()))
 
 
 def _constant_day(
-    m: int, conductance: float, ambient_c: float, payload_kg: float, box: CargoBoxParams
+    m: int, grid_s: float, conductance: float, at: tuple[float, float], box: CargoBoxParams
 ) -> BoxDay:
-    """``m`` steps of the programme at the depot: the walls alone, the outside air, on the grid."""
+    """``m`` steps of ``grid_s`` at the depot: the walls alone, the outside air (``at``: its
+    temperature [°C] and the goods aboard [kg]), on the grid."""
+    ambient_c, payload_kg = at
     return BoxDay(
-        seconds=np.full(m, GRID_S),
+        seconds=np.full(m, grid_s),
         conductance_w_k=np.full(m, conductance),
         equilibrium_c=np.full(m, ambient_c),
         payload_kg=np.full(m, payload_kg),

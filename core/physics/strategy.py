@@ -127,40 +127,34 @@ def optimal_schedule(
 
 def _equalities(
     box: CargoBoxParams, air_capacity_j_k: float, day: BoxDay, start_c: tuple[float, float]
-) -> tuple[list[int], list[int], list[float], FloatArray]:
-    """The box's two equations per step (module docstring) as sparse rows."""
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The box's two equations per step (module docstring) as sparse rows: the air's in row
+    ``2k``, the goods' in ``2k + 1``."""
     n = day.seconds.size
     a = air_capacity_j_k / day.seconds
     p = day.payload_kg * box.cargo_specific_heat_j_kgk / day.seconds
     h = day.payload_kg * box.product_conductance_w_kgk
     g = day.conductance_w_k
-    rows: list[int] = []
-    cols: list[int] = []
-    vals: list[float] = []
+    both = p + h
+    empty = both <= 0
+    keep = np.where(empty, 1.0, p)  # no goods: the node keeps its last value
+    k = np.arange(n)
+    air, goods = 2 * k, 2 * k + 1
+    at = _VARS * k
+    rest = k[1:]
+    rows = np.concatenate([air, air, air, air, goods, goods, air[rest], goods[rest]])
+    cols = np.concatenate(
+        [at + _TA, at + _TP, at + _Q, at + _H, at + _TP, at + _TA, at[:-1] + _TA, at[:-1] + _TP]
+    )
+    ones = np.ones(n)
+    vals = np.concatenate(
+        [a + g + h, -h, ones, -ones, np.where(empty, 1.0, both), -h, -a[rest], -keep[rest]]
+    )
     rhs = np.zeros(2 * n)
-
-    def put(row: int, k: int, var: int, value: float) -> None:
-        rows.append(row)
-        cols.append(_VARS * k + var)
-        vals.append(value)
-
-    for k in range(n):
-        air, goods = 2 * k, 2 * k + 1
-        put(air, k, _TA, a[k] + g[k] + h[k])
-        put(air, k, _TP, -h[k])
-        put(air, k, _Q, 1.0)
-        put(air, k, _H, -1.0)
-        rhs[air] = g[k] * day.equilibrium_c[k]
-        both = p[k] + h[k]
-        put(goods, k, _TP, both if both > 0 else 1.0)
-        put(goods, k, _TA, -h[k])
-        keep = p[k] if both > 0 else 1.0  # no goods: the node keeps its last value
-        if k:
-            put(air, k - 1, _TA, -a[k])
-            put(goods, k - 1, _TP, -keep)
-        else:
-            rhs[air] += a[k] * start_c[0]
-            rhs[goods] = keep * start_c[1]
+    rhs[air] = g * day.equilibrium_c
+    if n:
+        rhs[0] += a[0] * start_c[0]
+        rhs[1] = keep[0] * start_c[1]
     return rows, cols, vals, rhs
 
 
@@ -169,24 +163,23 @@ def _band_rows(band: ProductBand, day: BoxDay) -> tuple[object, FloatArray]:
     less its slack."""
     n = day.seconds.size
     aboard = np.flatnonzero(day.payload_kg > 0)
-    rows: list[int] = []
-    cols: list[int] = []
-    vals: list[float] = []
-    bounds: list[float] = []
-    low, high = band.min_c + MARGIN_K, band.max_c - MARGIN_K
-
-    def limit(var: int, slack: int, k: int, sign: float, bound: float) -> None:
-        row = len(bounds)
-        rows.extend((row, row))
-        cols.extend((_VARS * k + var, _VARS * k + slack))
-        vals.extend((sign, -1.0))
-        bounds.append(sign * bound)
-
-    for step in aboard.tolist():
-        limit(_TP, _S, step, 1.0, max(high, band.middle_c))
-        limit(_TP, _S, step, -1.0, min(low, band.middle_c))
-    for step in range(n):
-        limit(_TA, _U, step, 1.0, band.max_c)
-        limit(_TA, _U, step, -1.0, band.min_c)
-    matrix = coo_matrix((vals, (rows, cols)), shape=(len(bounds), _VARS * n)).tocsr()
-    return matrix, np.array(bounds)
+    high = max(band.max_c - MARGIN_K, band.middle_c)
+    low = min(band.min_c + MARGIN_K, band.middle_c)
+    limits = [  # variable, its slack, the steps, the sign, the bound
+        (_TP, _S, aboard, 1.0, high),
+        (_TP, _S, aboard, -1.0, -low),
+        (_TA, _U, np.arange(n), 1.0, band.max_c),
+        (_TA, _U, np.arange(n), -1.0, -band.min_c),
+    ]
+    steps = [s for _, _, s, _, _ in limits]
+    row = np.arange(sum(s.size for s in steps))
+    rows = np.concatenate([row, row])
+    cols = np.concatenate(
+        [_VARS * s + v for v, _, s, _, _ in limits] + [_VARS * s + u for _, u, s, _, _ in limits]
+    )
+    vals = np.concatenate(
+        [np.full(s.size, sign) for _, _, s, sign, _ in limits] + [-np.ones(row.size)]
+    )
+    bounds = np.concatenate([np.full(s.size, bound) for _, _, s, _, bound in limits])
+    matrix = coo_matrix((vals, (rows, cols)), shape=(row.size, _VARS * n)).tocsr()
+    return matrix, bounds
