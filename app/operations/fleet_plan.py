@@ -34,9 +34,12 @@ def fleet_problem(request: FleetPlanRequest, settings: Settings) -> FleetProblem
     errors name it (``vehicles[1].battery.min_soc``)."""
     check_fleet_size(request, len(request.vehicles), settings)
     vehicles = []
+    charger = request.depot.charger
     for index, vehicle in enumerate(request.vehicles):
         try:
-            van = van_of(vehicle, settings)
+            van = van_of(vehicle, settings).priced(
+                None if charger is None else charger.price_per_kwh
+            )
         except CoreError as error:
             raise error.under(f"vehicles[{index}]") from None
         vehicles.append(FleetVehicle(**fields_of(vehicle, ShiftFields), van=van))

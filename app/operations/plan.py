@@ -39,9 +39,10 @@ from core.planning.round.planner import check, plan
 def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
     """The core problem of a plan request, within the server's limits."""
     check_round(request, settings)
+    charger = request.depot.charger
     return PlanProblem(
         **fields_of(request, PlanFields) | search_limits(request, settings),
-        van=van_of(request, settings),
+        van=van_of(request, settings).priced(None if charger is None else charger.price_per_kwh),
     )
 
 

@@ -28,7 +28,7 @@ MIN_DISTANCE_FOR_PER_KM_M = 1.0
 
 def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResponse:
     """Energy of one speed trace, sent or generated (``POST /v1/simulate``)."""
-    van = van_of(request, settings)
+    van = van_of(request, settings).priced(None)
     if request.cycle is not None:
         cycle = request.cycle
         street = STREET_TYPES[cycle.street_type]
@@ -56,6 +56,7 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
             "speed_mps" if request.cycle is None else "cycle.distance_m",
         )
     check_trace(speed, request.dt_s)  # at least 2 samples; before asking for the weather
+    van.cargo_box.check_day((speed.size - 1) * request.dt_s)
     forecast, warnings = forecast_for(
         request.weather,
         connectors.weather_service(settings),

@@ -58,6 +58,9 @@ class ChargingSpell(Interval):
     power_kw: float = Field(
         ..., ge=0.1, le=1000, description="The charger's power [kW]; the van's curve caps it."
     )
+    price_per_kwh: float = Field(
+        0.0, ge=0, le=100, description="Price of the energy drawn from the grid [per kWh]."
+    )
 
 
 #: Lightest and densest traffic ε_t [–]: the traffic law t_0 = t_p·(1 − ε_t)/ε_t needs

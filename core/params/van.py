@@ -8,6 +8,7 @@ from typing import Any, Literal
 from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
+from core.exceptions import InvalidParameterError
 from core.params.base import Params
 from core.params.product import PRODUCT_CLASSES, Celsius, Product, ProductBand, product_band
 
@@ -314,6 +315,29 @@ class CargoBoxParams(Params):
         le=100_000,
         description="Most heat the box heater delivers [W] (dynamic mode only); at least 10 W.",
     )
+    control: Literal["variable", "on-off"] = Field(
+        "variable",
+        description="How the unit's compressor runs: 'variable' (an inverter: any power up to "
+        "refrigeration_capacity_w), or 'on-off' (a fixed-speed unit: full capacity or none, "
+        "switched by a thermostat with differential_k, each run and each pause at least "
+        "min_on_minutes and min_off_minutes). 'on-off' needs the dynamic mode and a product.",
+    )
+    differential_k: float = Field(
+        2.0,
+        ge=0.2,
+        le=10,
+        description="An on-off unit's switching differential [K]: on at the set-point plus "
+        "half of it, off at the set-point less half.",
+    )
+    min_on_minutes: float = Field(
+        3.0, ge=0, le=120, description="An on-off unit's shortest run [min] (compressor wear)."
+    )
+    min_off_minutes: float = Field(
+        3.0,
+        ge=0,
+        le=120,
+        description="An on-off unit's shortest pause [min] (pressures equalise before a start).",
+    )
 
     @classmethod
     def changed_values(cls, current: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
@@ -352,6 +376,27 @@ class CargoBoxParams(Params):
                     f"{band.max_c:g} °C"
                 )
         return value
+
+    @field_validator("control")
+    @classmethod
+    def _on_off_needs_a_capacity(cls, value: str, info: ValidationInfo) -> str:
+        data = info.data
+        if value == "on-off" and (data.get("mode") != "dynamic" or data.get("product") is None):
+            raise ValueError(
+                "control 'on-off' needs mode 'dynamic' (a finite capacity to switch) and a "
+                "product (the two-node box it is simulated in)"
+            )
+        return value
+
+    def check_day(self, day_s: float) -> None:
+        """An error naming ``min_on_minutes`` when an on-off unit's shortest run is longer
+        than the day of ``day_s`` [s]: a strategy the unit cannot follow."""
+        if self.control == "on-off" and self.min_on_minutes * 60.0 > day_s:
+            raise InvalidParameterError(
+                f"an on-off unit cannot follow a day of {day_s / 60:.0f} min with a shortest "
+                f"run of {self.min_on_minutes:g} min",
+                "cargo_box.min_on_minutes",
+            )
 
     @property
     def band(self) -> ProductBand | None:
@@ -493,10 +538,21 @@ class RefrigerationStrategy(Params):
         "the depot on grid power, the air let float within the band, cooling while plugged "
         "in), then simulated; needs cargo_box.product.",
     )
-    objective: Literal["energy"] = Field(
+    objective: Literal["energy", "cost"] = Field(
         "energy",
         description="What the optimal strategy spares: 'energy', the battery's (the grid's, "
-        "while plugged in or before departure, counts a tenth).",
+        "while plugged in or before departure, counts a tenth); 'cost', the money — the "
+        "battery's kWh at the depot's price over the charging efficiency (refilled there), "
+        "the grid's at the price where the van is plugged in (depot_price_per_kwh, the "
+        "chargers' price_per_kwh).",
+    )
+    depot_price_per_kwh: float | None = Field(
+        None,
+        ge=0,
+        le=100,
+        description="The depot's price of energy [per kWh] for the 'cost' objective: "
+        "pre-cooling there, and refilling the battery. Absent: the depot charger's "
+        "price_per_kwh (plans), required otherwise.",
     )
     precool_minutes: float = Field(
         60.0,
@@ -505,6 +561,19 @@ class RefrigerationStrategy(Params):
         description="Minutes plugged in at the depot before departure the optimal strategy may "
         "cool the box and the goods on grid power (a van that leaves the depot).",
     )
+
+    def priced(self, depot_price_per_kwh: float | None) -> RefrigerationStrategy:
+        """The strategy with the depot's price when it has none of its own; the 'cost'
+        objective without a price above 0 is an error naming ``objective``."""
+        price = self.depot_price_per_kwh
+        price = depot_price_per_kwh if price is None else price
+        if self.objective == "cost" and not price:
+            raise InvalidParameterError(
+                "objective 'cost' needs a price above 0: refrigeration.depot_price_per_kwh "
+                "or the depot charger's price_per_kwh",
+                "refrigeration.objective",
+            )
+        return self.model_copy(update={"depot_price_per_kwh": price})
 
 
 class VanParams(Params):
@@ -531,6 +600,13 @@ class VanParams(Params):
         default_factory=RefrigerationStrategy,
         description="How the refrigeration unit is run: a thermostat, or the optimal schedule.",
     )
+
+    def priced(self, depot_price_per_kwh: float | None) -> VanParams:
+        """The van with the depot's price of energy for its refrigeration's objective
+        (:meth:`RefrigerationStrategy.priced`)."""
+        return self.model_copy(
+            update={"refrigeration": self.refrigeration.priced(depot_price_per_kwh)}
+        )
 
     @field_validator("refrigeration")
     @classmethod

@@ -105,6 +105,11 @@ def two_nodes(
     steady = box.mode == "steady"
     cool_w = math.inf if steady else box.refrigeration_capacity_w
     heat_w = (math.inf if steady else box.heating_capacity_w) if box.heater_enabled else 0.0
+    switching = (
+        (box.differential_k, box.min_on_minutes * 60.0, box.min_off_minutes * 60.0)
+        if box.control == "on-off"
+        else (0.0, 0.0, 0.0)
+    )
     mass = mean(payload_kg)
     cool_to, heat_to = setpoint_c if isinstance(setpoint_c, tuple) else (setpoint_c, setpoint_c)
     air, product, removed, added = _integrate(
@@ -115,6 +120,7 @@ def two_nodes(
         mass * box.product_conductance_w_kgk,
         counts * dt_s,
         (cool_w, heat_w),
+        switching,
         start_c,
     )
     product[mass <= 0] = np.nan
@@ -139,19 +145,25 @@ def _integrate(
     h: FloatArray,
     seconds: FloatArray,
     unit: tuple[float, float],
+    switching: tuple[float, float, float],
     start: tuple[float, float],
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Backward Euler over the blocks: the goods' equation solved for ``ϑ_p`` leaves the air's
     ``K·ϑ_a' = R − Q̇_0`` with ``K = C_a/Δt + G + k``, ``R = C_a/Δt·ϑ_a + G·ϑ_eq + k·ϑ_p`` and
     ``k = (C_p/Δt)·H/(C_p/Δt + H)``; the unit's ``Q̇_0 = R − K·ϑ_set`` within its limits
-    (``setpoint``: the air it cools down to, and the air it heats up to)."""
+    (``setpoint``: the air it cools down to, and the air it heats up to). An on-off unit
+    (``switching``: its differential [K] above 0, its shortest run and pause [s]) removes its
+    full capacity or nothing: on once the air is above the set-point by half the differential,
+    off once below it by half, each run and pause lasting their shortest at least."""
     cool_to, heat_to = setpoint
     c_air, c_product = capacity
     cool_w, heat_w = unit
+    differential, min_on, min_off = switching
     n = g.size
     air, product = np.empty(n), np.empty(n)
     removed, added = np.zeros(n), np.zeros(n)
     ta, tp = start
+    on, since = False, min_off  # a unit at rest long enough to start
     for i in range(n):
         a = c_air / seconds[i]
         p = c_product[i] / seconds[i]
@@ -159,9 +171,21 @@ def _integrate(
         k = p * h[i] / both if both > 0 else 0.0
         big_k = a + g[i] + k
         r = a * ta + g[i] * eq[i] + k * tp
-        q = min(r - big_k * cool_to[i], cool_w)
-        if q < 0:  # the air would end below the cooling set-point: heat only up to the other
-            q = max(min(r - big_k * heat_to[i], 0.0), -heat_w)
+        if differential > 0:
+            switch = (
+                ta > cool_to[i] + 0.5 * differential
+                if not on
+                else ta < cool_to[i] - 0.5 * differential
+            )
+            if switch and since >= (min_on if on else min_off):
+                on, since = not on, 0.0
+            since += seconds[i]
+            q = cool_w if on else 0.0
+        else:
+            q = min(r - big_k * cool_to[i], cool_w)
+        if q <= 0:  # the air would end below the cooling set-point: heat only up to the other
+            # (an on-off unit's: below its own differential)
+            q = max(min(r - big_k * (heat_to[i] - 0.5 * differential), 0.0), -heat_w)
         ta = (r - q) / big_k
         if both > 0:
             tp = (p * tp + h[i] * ta) / both
@@ -176,12 +200,29 @@ def _integrate(
 @dataclass(frozen=True)
 class Run:
     """How the unit runs: its strategy, the share of each step the van is plugged in (its
-    consumers on the grid), and whether it leaves the depot (the optimal strategy may pre-cool
-    there)."""
+    consumers on the grid) and that share times the price there [per kWh], whether it leaves
+    the depot (the optimal strategy may pre-cool there), and the battery's charging
+    efficiency (what refilling a kWh costs)."""
 
     strategy: RefrigerationStrategy
     plugged: FloatArray
     from_depot: bool = True
+    priced: FloatArray | None = None
+    charging_efficiency: float = 1.0
+
+    def weights(self) -> tuple[FloatArray, float]:
+        """What a joule drawn in each step weighs in the strategy's objective, against one
+        from the battery, and one drawn at the depot before departure: the grid's at
+        :data:`core.physics.strategy.GRID_WEIGHT` ('energy'), or at its price over the
+        battery's — the depot's over the charging efficiency ('cost')."""
+        on_battery = 1.0 - self.plugged
+        strategy = self.strategy
+        if strategy.objective == "energy":
+            return on_battery + GRID_WEIGHT * self.plugged, GRID_WEIGHT
+        assert strategy.depot_price_per_kwh  # RefrigerationStrategy.priced
+        battery_price = strategy.depot_price_per_kwh / self.charging_efficiency
+        priced = np.zeros_like(self.plugged) if self.priced is None else self.priced
+        return on_battery + priced / battery_price, self.charging_efficiency
 
 
 #: The box's surroundings over a trace, per step: the ambient [°C], the sun on the box [W] and
@@ -299,6 +340,7 @@ def plan_setpoints(
     the box's state."""
     ambient = outside[0]
     _, conductance, equilibrium = _flows(box, outside)
+    weights, at_depot = run.weights()
     n = ambient.size
     blocks = Blocks(n, max(round(grid_s / dt_s), 1))
     counts, mean = blocks.counts, blocks.mean
@@ -312,20 +354,24 @@ def plan_setpoints(
             cop=np.broadcast_to(
                 refrigeration_cop(box, grid_outside, box.setpoint_c), grid_outside.shape
             ),
-            weight=1.0 - (1.0 - GRID_WEIGHT) * mean(run.plugged),
+            weight=mean(weights),
         )
     ]
     m = math.ceil(run.strategy.precool_minutes * 60.0 / grid_s) if run.from_depot and n else 0
     if m:  # at the depot, door shut, out of the sun, on the grid
         wall = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
         days.insert(
-            0, _constant_day(m, grid_s, wall, (float(ambient[0]), float(payload_kg[0])), box)
+            0,
+            _constant_day(
+                m, (grid_s, at_depot), wall, (float(ambient[0]), float(payload_kg[0])), box
+            ),
         )
     day = BoxDay(
         *(np.concatenate([getattr(d, f) for d in days]) for f in BoxDay.__dataclass_fields__)
     )
     assert box.band is not None  # the strategy needs a product (VanParams)
-    schedule = optimal_schedule(box, box.band, air_heat_capacity_j_k(box), day, start_c)
+    air_capacity = air_heat_capacity_j_k(box)
+    schedule = optimal_schedule(box, box.band, air_capacity, day, start_c, m)
     departure = start_c
     if m:
         goods = float(schedule.product_c[m - 1])
@@ -339,14 +385,48 @@ def plan_setpoints(
         np.arange(1, n + 1) * dt_s, np.append(0.0, ends_s), np.append(departure[0], air)
     )
     heat_to = np.repeat(np.where(schedule.added_w[m:] > 0, air, box.band.min_c), counts)
-    return Setpoints(cool_to, heat_to, departure, float(electric[:m].sum()))
+    precool_j = _precool_j(
+        box,
+        BoxDay(*(getattr(day, f)[:m] for f in BoxDay.__dataclass_fields__)),
+        electric[:m],
+        start_c,
+    )
+    return Setpoints(cool_to, heat_to, departure, precool_j)
+
+
+def _precool_j(
+    box: CargoBoxParams, window: BoxDay, electric_j: FloatArray, start_c: tuple[float, float]
+) -> float:
+    """Pre-cooling: what the programme drew in the depot's ``window`` (``electric_j`` [J] per
+    step) beyond holding the box as it starts — what the thermostat's day assumes of those
+    minutes; at least nothing."""
+    if not window.seconds.size:
+        return 0.0
+    held = two_nodes(
+        box,
+        air_heat_capacity_j_k(box),
+        window.conductance_w_k,
+        window.equilibrium_c,
+        window.payload_kg,
+        np.full(window.seconds.size, start_c[0]),
+        float(window.seconds[0]),
+        start_c,
+    )
+    holding = (held.removed_w / window.cop + held.added_w / box.heating_cop) * window.seconds
+    return max(float(electric_j.sum() - holding.sum()), 0.0)
 
 
 def _constant_day(
-    m: int, grid_s: float, conductance: float, at: tuple[float, float], box: CargoBoxParams
+    m: int,
+    step: tuple[float, float],
+    conductance: float,
+    at: tuple[float, float],
+    box: CargoBoxParams,
 ) -> BoxDay:
-    """``m`` steps of ``grid_s`` at the depot: the walls alone, the outside air (``at``: its
-    temperature [°C] and the goods aboard [kg]), on the grid."""
+    """``m`` steps at the depot (``step``: their length [s] and what a joule weighs there):
+    the walls alone, the outside air (``at``: its temperature [°C] and the goods aboard
+    [kg]), on the grid."""
+    grid_s, weight = step
     ambient_c, payload_kg = at
     return BoxDay(
         seconds=np.full(m, grid_s),
@@ -354,7 +434,7 @@ def _constant_day(
         equilibrium_c=np.full(m, ambient_c),
         payload_kg=np.full(m, payload_kg),
         cop=np.full(m, float(refrigeration_cop(box, ambient_c, box.setpoint_c))),
-        weight=np.full(m, GRID_WEIGHT),
+        weight=np.full(m, weight),
     )
 
 

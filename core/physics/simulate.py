@@ -107,6 +107,8 @@ class SimulationResult:
     plugged
         The share of each step plugged in at a charger [–] (the consumers on the grid),
         ``n − 1`` values.
+    plugged_price_per_kwh
+        That share times the charger's price [per kWh], ``n − 1`` values.
     """
 
     time_s: FloatArray
@@ -128,6 +130,7 @@ class SimulationResult:
     charges: list[ChargeOutcome] = field(default_factory=list)
     asked_s: FloatArray | None = None
     plugged: FloatArray = field(default_factory=lambda: np.zeros(0))
+    plugged_price_per_kwh: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     def sample_at(self, asked_sample: ArrayLike) -> Any:
         """The sample that the van drove at the place of a sample of the trace asked for."""
@@ -332,6 +335,7 @@ def _result(
         charges=charges,
         asked_s=trace.asked_s,
         plugged=plugged_share(trace.charging, n - 1, dt_s),
+        plugged_price_per_kwh=plugged_share(trace.charging, n - 1, dt_s, priced=True),
     )
 
 
@@ -448,6 +452,8 @@ def _consumers(
                 van.refrigeration,
                 plugged_share(trace.charging, n_steps, dt_s),
                 initial_c is None,
+                plugged_share(trace.charging, n_steps, dt_s, priced=True),
+                van.battery.charging_efficiency,
             ),
         )
     cab_gap_j = 0.0 if box_start_c is not None else _cab_gap_j(van, outside.start_c)
@@ -580,13 +586,17 @@ def _energy_kwh(power_w: dict[str, FloatArray], dt_s: float) -> dict[str, float]
     return energy
 
 
-def plugged_share(charging: Sequence[ChargingSpell], n_steps: int, dt_s: float) -> FloatArray:
-    """Share of each step [–] plugged in at a charger."""
+def plugged_share(
+    charging: Sequence[ChargingSpell], n_steps: int, dt_s: float, priced: bool = False
+) -> FloatArray:
+    """Share of each step [–] plugged in at a charger; ``priced``: times its price [per
+    kWh]."""
     return interval_rates(
         [c.start_s for c in charging],
         [c.start_s + c.duration_s for c in charging],
         n_steps,
         dt_s,
+        [c.price_per_kwh for c in charging] if priced else None,
     )
 
 

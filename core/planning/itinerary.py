@@ -32,6 +32,7 @@ class ChargeVisit:
     power_kw: float
     open_s: Windows = ()
     reloads: bool = False
+    price_per_kwh: float = 0.0
 
 
 @dataclass(frozen=True)

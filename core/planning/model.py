@@ -538,6 +538,18 @@ class RefrigerationResult(Result):
         description="What a thermostat at cargo_box.setpoint_c would have drawn from the "
         "battery on the same day [kWh] (the thermostat strategy: battery_kwh).",
     )
+    objective: Literal["energy", "cost"] = Field(
+        "energy", description="What the strategy spared (refrigeration.objective)."
+    )
+    cost: float | None = Field(
+        None,
+        description="What the unit's energy costs: the battery's kWh refilled at the depot's "
+        "price over the charging efficiency, the grid's at the depot's and the chargers' "
+        "price_per_kwh; null without a depot price.",
+    )
+    thermostat_cost: float | None = Field(
+        None, description="What a thermostat's would have cost on the same day, alike."
+    )
     schedule: list[ScheduleInterval] = Field(
         ...,
         description="The unit's set-point and power, stretch by stretch (a set-point schedule "

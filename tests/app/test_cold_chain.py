@@ -226,3 +226,112 @@ def test_the_optimal_strategy_needs_a_product_and_each_van_has_its_own(client):
         assert strategy == ("optimal" if route["vehicle_id"] == "van-1" else "thermostat")
     fleet["vehicles"][1]["refrigeration"] = {"strategy": "optimal"}  # van-2 has no product
     assert post_both_ways(client, "/v1/fleet-plans", fleet)[0] == ["vehicles[1].refrigeration"]
+
+
+PRICED_DEPOT = PLAN_EXAMPLE["depot"] | {"charger": {"power_kw": 22, "price_per_kwh": 0.3}}
+
+
+def test_the_cost_objective_prices_the_battery_at_the_depot_and_costs_least(client):
+    from core.params import get_preset
+
+    cargo = DYNAMIC | {"product": "chilled-dairy", "load_temperature_c": 4.0}
+    answers = {
+        objective: client.post(
+            "/v1/plans",
+            json=PLAN_EXAMPLE
+            | {
+                "depot": PRICED_DEPOT,
+                "cargo_box": cargo,
+                "refrigeration": {"strategy": "optimal", "objective": objective},
+            },
+        ).json()
+        for objective in ("energy", "cost")
+    }
+    refill = 0.3 / get_preset(PLAN_EXAMPLE["vehicle"]["preset"]).battery.charging_efficiency
+    for objective, answer in answers.items():
+        rf = answer["refrigeration"]
+        assert rf["objective"] == objective
+        assert answer["charges"] == []  # the grid's energy is the depot's pre-cooling alone
+        # by hand: the battery's kWh refilled at the depot, the pre-cooling at its price
+        assert rf["cost"] == pytest.approx(rf["battery_kwh"] * refill + rf["grid_kwh"] * 0.3)
+        assert rf["thermostat_cost"] == pytest.approx(rf["thermostat_battery_kwh"] * refill)
+        assert check_agrees(answer)["verdict"] == "holds"
+    cheapest, sparing = answers["cost"]["refrigeration"], answers["energy"]["refrigeration"]
+    # the grid's kWh at the depot costs the battery's less the charging losses, not a tenth:
+    # pre-cooling pays less, and the day costs less than the energy objective's and the
+    # thermostat's
+    assert cheapest["grid_kwh"] < sparing["grid_kwh"]
+    assert cheapest["cost"] < min(sparing["cost"], sparing["thermostat_cost"])
+    # without a price it is not asked for: null
+    plain = plan(client, cargo)["refrigeration"]
+    assert plain["cost"] is None and plain["objective"] == "energy"
+
+
+def test_the_cost_objective_needs_a_price(client):
+    cargo = DYNAMIC | {"product": "chilled-dairy"}
+    cost = {"strategy": "optimal", "objective": "cost"}
+    body = PLAN_EXAMPLE | {"cargo_box": cargo, "refrigeration": cost}
+    assert post_both_ways(client, "/v1/plans", body)[0] == ["refrigeration.objective"]
+    free = PLAN_EXAMPLE["depot"] | {"charger": {"power_kw": 22, "price_per_kwh": 0.0}}
+    assert post_both_ways(client, "/v1/plans", body | {"depot": free})[0] == [
+        "refrigeration.objective"
+    ]
+    priced = body | {"refrigeration": cost | {"depot_price_per_kwh": 0.25}}
+    assert client.post("/v1/plans", json=priced).status_code == 200
+    simulated = _simulate(cargo) | {"refrigeration": cost}
+    assert named(client.post("/v1/simulate", json=simulated), simulated) == [
+        "refrigeration.objective"
+    ]
+    fleet = copy.deepcopy(FLEET_PLAN_EXAMPLE)
+    fleet["depot"].pop("charger", None)
+    fleet["vehicles"][0] |= {"cargo_box": cargo, "refrigeration": cost}
+    assert post_both_ways(client, "/v1/fleet-plans", fleet)[0] == [
+        "vehicles[0].refrigeration.objective"
+    ]
+
+
+ON_OFF = DYNAMIC | {"product": "chilled-dairy", "load_temperature_c": 4.0, "control": "on-off"}
+
+
+def test_an_on_off_unit_runs_at_full_capacity_or_not_at_all_and_the_strategy_spares_it(client):
+    from app.examples import SIMULATE_EXAMPLE
+
+    answers = {
+        strategy: client.post(
+            "/v1/plans",
+            json=PLAN_EXAMPLE | {"cargo_box": ON_OFF, "refrigeration": {"strategy": strategy}},
+        ).json()
+        for strategy in ("thermostat", "optimal")
+    }
+    for answer in answers.values():
+        assert check_agrees(answer)["verdict"] == "holds"
+    kept, planned = (answers[s]["refrigeration"] for s in ("thermostat", "optimal"))
+    assert planned["battery_kwh"] < 0.9 * kept["battery_kwh"]
+    # the simulated trace: the compressor's heat is its capacity or none
+    body = SIMULATE_EXAMPLE | {"cargo_box": ON_OFF, "include_series": True}
+    answer = client.post("/v1/simulate", json=body)
+    assert answer.status_code == 200, answer.text[:500]
+    power = answer.json()["series"]["power_w"]["refrigeration"]
+    assert len({round(p, 6) for p in power}) > 1  # it switches
+
+
+@pytest.mark.parametrize(
+    ("cargo_box", "field"),
+    [
+        ({"product": "chilled-dairy", "control": "on-off"}, "cargo_box.control"),  # steady mode
+        (DYNAMIC | {"control": "on-off"}, "cargo_box.control"),  # no product
+        (ON_OFF | {"control": "pulsed"}, "cargo_box.control"),
+        (ON_OFF | {"min_on_minutes": 121}, "cargo_box.min_on_minutes"),
+        (ON_OFF | {"differential_k": "NaN"}, "cargo_box.differential_k"),
+    ],
+)
+def test_a_unit_that_cannot_switch_so_is_a_422_naming_the_field(client, cargo_box, field):
+    body = PLAN_EXAMPLE | {"cargo_box": cargo_box}
+    assert post_both_ways(client, "/v1/plans", body)[0] == [field]
+
+
+def test_a_shortest_run_longer_than_the_day_is_a_422(client):
+    body = _simulate(ON_OFF | {"min_on_minutes": 120})
+    answer = client.post("/v1/simulate", json=body)
+    assert named(answer, body) == ["cargo_box.min_on_minutes"]
+    assert "shortest run of 120 min" in answer.text

@@ -461,7 +461,10 @@ def _visit(
     van of ``kind``, at its charging curve."""
     instance = charging.instance
     charge_s = charge_j * float(instance.charge_time_of(kind)[q])
-    return ChargeVisit(instance.service[q], charge_s, charging.points[place].power_kw)
+    point = charging.points[place]
+    return ChargeVisit(
+        instance.service[q], charge_s, point.power_kw, price_per_kwh=point.price_per_kwh
+    )
 
 
 def _held(

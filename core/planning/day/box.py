@@ -81,10 +81,27 @@ def refrigeration(
     def kwh(watts: FloatArray, share: FloatArray) -> float:
         return float((watts * share).sum()) * PLAN_DT_S / JOULES_PER_KWH
 
+    strategy = van.refrigeration
+    battery_kwh = kwh(power, on_battery)
+    precool_kwh = box.precool_grid_j / JOULES_PER_KWH
+    thermostat_kwh = kwh(thermostat, on_battery)
+    depot_price = strategy.depot_price_per_kwh
+
+    def cost(battery: float, watts: FloatArray, precool: float) -> float | None:
+        if depot_price is None:
+            return None
+        refill = depot_price / van.battery.charging_efficiency
+        return (
+            battery * refill + kwh(watts, simulated.plugged_price_per_kwh) + precool * depot_price
+        )
+
     return RefrigerationResult(
-        strategy=van.refrigeration.strategy,
-        battery_kwh=kwh(power, on_battery),
-        grid_kwh=kwh(power, simulated.plugged) + box.precool_grid_j / JOULES_PER_KWH,
-        thermostat_battery_kwh=kwh(thermostat, on_battery),
+        strategy=strategy.strategy,
+        objective=strategy.objective,
+        battery_kwh=battery_kwh,
+        grid_kwh=kwh(power, simulated.plugged) + precool_kwh,
+        thermostat_battery_kwh=thermostat_kwh,
+        cost=cost(battery_kwh, power, precool_kwh),
+        thermostat_cost=cost(thermostat_kwh, thermostat, 0.0),
         schedule=schedule,
     )

@@ -414,7 +414,9 @@ def _charge_options(
                 rate_w = float(curve.power_at_w(reserve)[()]) * curve.efficiency
                 added_s += (needed - 1.0) * capacity_j / rate_w + detour_s + plug_s
             full_s = min(curve.time_s(plugged, 1.0), MAX_CHARGE_S)
-            visit = ChargeVisit(plug_s, full_s, point.power_kw, open_s)
+            visit = ChargeVisit(
+                plug_s, full_s, point.power_kw, open_s, price_per_kwh=point.price_per_kwh
+            )
             options.append(_Option(p, place, added_s, visit))
     return sorted(options, key=lambda o: (o.added_s, -o.cut))
 
@@ -443,7 +445,7 @@ def _reload_charge(
         return None  # another van takes the point before the charge is done, or too slow
     added_s = max(standing_s - day.problem.reload_minutes * 60, 0.0)
     full_s = min(curve.time_s(arriving, 1.0), MAX_CHARGE_S)
-    visit = ChargeVisit(plug_s, full_s, point.power_kw, open_s, True)
+    visit = ChargeVisit(plug_s, full_s, point.power_kw, open_s, True, point.price_per_kwh)
     return _Option(p, 0, added_s, visit, inserted=False)
 
 

@@ -436,6 +436,7 @@ class _Builder:
                     start_s=self.clock * PLAN_DT_S,
                     duration_s=charge * PLAN_DT_S,
                     power_kw=visit.power_kw,
+                    price_per_kwh=visit.price_per_kwh,
                 )
             )
         self.stand(charge + plug, self.payload_kg)

@@ -100,6 +100,7 @@ def simulate_route(
             itinerary = itinerary.shifted(delay_s)
             timeline = laid_out(start, windows_s)
     check_representable(start, timeline.duration_s, "date")
+    problem.van.cargo_box.check_day(timeline.duration_s)
     weather, warnings = scene.weather_for(start, timeline.duration_s)
     warnings = [*warnings, *_long_day(problem, start, timeline)]
     result = simulate(

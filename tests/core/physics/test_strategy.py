@@ -2,7 +2,9 @@
 cold_chain.box_with_goods): an empty box let warm to its band's ceiling against a thermostat by
 hand, the goods' thermal mass and pre-cooling spared from the battery with the goods inside
 their band, the simulation following the programme's schedule, a winter day kept above the
-floor by the heater, and a day the unit cannot hold answered with the band broken."""
+floor by the heater, a day the unit cannot hold answered with the band broken, the cost
+objective's weights by hand, an on-off unit's runs and pauses, and the receding horizon's
+re-plan from a warm box under way."""
 
 from __future__ import annotations
 
@@ -13,7 +15,15 @@ import pytest
 
 from core.params import PRODUCT_CLASSES, CargoBoxParams, RefrigerationStrategy, get_preset
 from core.physics.cargo import air_heat_capacity_j_k
-from core.physics.cold_chain import Run, box_with_goods, check_cold_chain
+from core.physics.cold_chain import (
+    Run,
+    _flows,
+    box_with_goods,
+    check_cold_chain,
+    follow,
+    plan_setpoints,
+    two_nodes,
+)
 from core.physics.strategy import MARGIN_K
 
 HOUR = 3600
@@ -124,3 +134,62 @@ def test_a_day_the_unit_cannot_hold_is_answered_with_the_band_broken():
     )
     check = check_cold_chain(PRODUCT_CLASSES["chilled-minced-meat"], result.product_c, 1.0)
     assert not check.holds and "above their band's 2 °C" in (check.reason or "")
+
+
+def test_the_objectives_weights_by_hand():
+    # a quarter of the first step and all of the second plugged in, at 0.40 per kWh there;
+    # the depot at 0.30 with charging at 90 %: a battery kWh costs 0.30/0.9 = 0.333
+    plugged = np.array([0.25, 1.0, 0.0])
+    energy, at_depot = Run(OPTIMAL, plugged).weights()
+    assert energy == pytest.approx([0.75 + 0.025, 0.1, 1.0]) and at_depot == 0.1
+    cost = OPTIMAL.model_copy(update={"objective": "cost", "depot_price_per_kwh": 0.3})
+    weights, at_depot = Run(cost, plugged, priced=plugged * 0.4, charging_efficiency=0.9).weights()
+    battery = 0.3 / 0.9
+    assert weights == pytest.approx([0.75 + 0.1 / battery, 0.4 / battery, 1.0])
+    assert at_depot == pytest.approx(0.9)  # a grid kWh at the depot against a refilled one
+
+
+def test_an_on_off_unit_runs_full_or_not_at_all_for_its_shortest_run_and_pause():
+    # the thermostat on a fixed-speed unit (2 K differential, 3-minute runs and pauses): the
+    # heat it removes is its capacity or none, every run and pause but the last lasts at
+    # least 3 minutes, and the air swings about the set-point by about the differential
+    box = reference_box(mode="dynamic", control="on-off", min_on_minutes=3.0, min_off_minutes=3.0)
+    n = 4 * HOUR
+    outside = (np.full(n, 30.0), np.zeros(n), np.zeros(n))
+    nodes = two_nodes(
+        box,
+        air_heat_capacity_j_k(box),
+        *_flows(box, outside)[1:],
+        np.full(n, 500.0),
+        np.full(n, box.setpoint_c),
+        1.0,
+        (box.setpoint_c, box.load_c),
+    )
+    capacity = box.refrigeration_capacity_w
+    assert set(np.unique(nodes.removed_w)) == {0.0, capacity}
+    on = nodes.removed_w > 0
+    edges = np.flatnonzero(np.diff(on.astype(int))) + 1
+    spells = np.diff(np.concatenate(([0], edges, [n])))
+    assert len(spells) > 6  # it switches many times in four hours
+    assert spells[1:-1].min() >= 180  # the first spell starts at rest; the last is cut off
+    settled = nodes.air_c[HOUR:]
+    assert settled.max() - settled.min() == pytest.approx(box.differential_k, abs=1.0)
+
+
+def test_a_re_plan_from_a_warm_box_under_way_brings_the_air_back_and_keeps_the_goods():
+    # the receding horizon: a long stop has left the air at 12 °C and the goods at 5.2 °C;
+    # the rest of the day planned from that state (no depot minutes) keeps the goods inside
+    # dairy's 0–6 °C band and draws less than the thermostat from the same state
+    box = reference_box()
+    n = 3 * HOUR
+    outside = (np.full(n, 30.0), np.full(n, 250.0), np.zeros(n))
+    payload = np.full(n, 300.0)
+    start = (12.0, 5.2)
+    run = Run(RefrigerationStrategy(strategy="optimal"), np.zeros(n), from_depot=False)
+    planned = plan_setpoints(box, outside, payload, 1.0, start, run)
+    assert planned.departure_c == start and planned.precool_grid_j == 0.0
+    followed = follow(box, outside, payload, 1.0, planned)
+    check = check_cold_chain(PRODUCT_CLASSES["chilled-dairy"], followed.product_c, 1.0)
+    assert check.holds and check.product_max_c <= 6.0
+    kept = box_with_goods(box, outside, payload, 1.0, start, Run(THERMOSTAT, np.zeros(n)))
+    assert followed.power_w.sum() < kept.power_w.sum()
