@@ -2,8 +2,10 @@
 (``app.operations.plan.run_plan``, what ``POST /v1/plans`` runs): the reference summer day
 (the ev-van-3.5t-reefer, 30 °C, 30 stops with 2-minute doors, chilled dairy at +6 °C at most,
 500 kg loaded at +4 °C) with a thermostat and with the optimal schedule, a frozen day, a
-winter day, and a day whose battery the thermostat runs below its reserve; the battery energy
-of each, the grid's for pre-cooling, the goods' extremes and verdict, and the answer's time."""
+winter day, a day whose battery the thermostat runs below its reserve, a fixed-speed (on-off)
+unit's day and a day priced at the depot (the cost objective beside the energy one); the
+battery energy of each, the grid's for pre-cooling, the cost, the goods' extremes and
+verdict, and the answer's time."""
 
 from __future__ import annotations
 
@@ -22,6 +24,8 @@ STOPS = 30
 DOOR_S = 120
 SERVICE_S = 300
 PAYLOAD_KG = 500.0
+#: The depot's charger on the priced day.
+PRICED_CHARGER = {"power_kw": 22, "price_per_kwh": 0.3}
 
 
 def reference_day(**changes: Any) -> dict[str, Any]:
@@ -53,18 +57,24 @@ def reference_day(**changes: Any) -> dict[str, Any]:
     return body | changes
 
 
-def planned(body: dict[str, Any], strategy: str) -> tuple[PlanResult, float]:
-    request = PlanRequest.model_validate(body | {"refrigeration": {"strategy": strategy}})
+#: The strategies each day is planned with: the thermostat first (the rows' reference).
+STRATEGIES = [("thermostat", {"strategy": "thermostat"}), ("optimal", {"strategy": "optimal"})]
+
+
+def planned(body: dict[str, Any], refrigeration: dict[str, str]) -> tuple[PlanResult, float]:
+    request = PlanRequest.model_validate(body | {"refrigeration": refrigeration})
     settings = Settings()
     result = run_plan(request, settings)
     return result, best_time_s(lambda: run_plan(request, settings), repeat=3)
 
 
-def rows_of(name: str, body: dict[str, Any]) -> list[list[object]]:
+def rows_of(
+    name: str, body: dict[str, Any], strategies: list[tuple[str, dict[str, str]]] = STRATEGIES
+) -> list[list[object]]:
     rows = []
     kept: tuple[PlanResult, float] | None = None
-    for strategy in ("thermostat", "optimal"):
-        result, seconds = planned(body, strategy)
+    for label, refrigeration in strategies:
+        result, seconds = planned(body, refrigeration)
         kept = kept or (result, seconds)
         unit, chain = result.refrigeration, result.cold_chain
         assert unit is not None and chain is not None
@@ -73,10 +83,11 @@ def rows_of(name: str, body: dict[str, Any]) -> list[list[object]]:
         rows.append(
             [
                 name,
-                strategy,
+                label,
                 f"{unit.battery_kwh:.2f}",
                 f"{(unit.battery_kwh / base.battery_kwh - 1) * 100:+.1f} %",
                 f"{unit.grid_kwh:.2f}",
+                "–" if unit.cost is None else f"{unit.cost:.3f}",
                 f"{chain.product_min_c:.1f} … {chain.product_max_c:.1f}",
                 chain.verdict,
                 f"{result.battery.min_soc:.1%} ({'holds' if result.battery.feasible else 'below'})",
@@ -104,8 +115,8 @@ def test_days() -> list[tuple[str, dict[str, Any]]]:
 def main() -> None:
     days = test_days()
     reference = days[0][1]
-    thermostat, _ = planned(reference, "thermostat")
-    optimal, _ = planned(reference, "optimal")
+    thermostat, _ = planned(reference, {"strategy": "thermostat"})
+    optimal, _ = planned(reference, {"strategy": "optimal"})
     # a battery between what the two draw: the thermostat runs it below its reserve
     used = [
         (r.legs[0].soc_start - r.battery.min_soc) * r.battery.usable_capacity_kwh
@@ -119,11 +130,22 @@ def main() -> None:
             "min_soc": 0.1,
         }
     )
+    on_off = reference_day(
+        cargo_box={"product": "chilled-dairy", "load_temperature_c": 4.0, "control": "on-off"}
+    )
+    priced = reference_day(
+        depot={"id": "depot", "lat": 48.21, "lon": 16.37, "charger": PRICED_CHARGER}
+    )
+    by_cost = [*STRATEGIES, ("optimal, cost", {"strategy": "optimal", "objective": "cost"})]
     rows = [
         row
-        for name, body in [*days, ("summer, a tight battery", tight)]
+        for name, body in [
+            *days,
+            ("summer, a tight battery", tight),
+            ("summer, an on-off unit", on_off),
+        ]
         for row in rows_of(name, body)
-    ]
+    ] + rows_of("summer, the depot at 0.30/kWh", priced, by_cost)
     print_table(
         "Refrigeration strategy on planned days (run_plan, 30 stops, ev-van-3.5t-reefer)",
         [
@@ -132,6 +154,7 @@ def main() -> None:
             "refrigeration from the battery [kWh]",
             "vs thermostat",
             "from the grid [kWh] (pre-cooling)",
+            "cost (battery refilled at the depot)",
             "goods [°C]",
             "cold chain",
             "lowest charge (reserve)",
