@@ -249,6 +249,11 @@ CHILLED_PLAN_EXAMPLE: dict[str, Any] = PLAN_EXAMPLE | {
 FROZEN_PLAN_EXAMPLE: dict[str, Any] = PLAN_EXAMPLE | {
     "cargo_box": {"product": "frozen", "mode": "dynamic", "refrigeration_capacity_w": 4000.0}
 }
+#: The chilled round with the unit's optimal strategy: pre-cooled at the depot, the air let
+#: float within the band, the battery spared.
+OPTIMAL_PLAN_EXAMPLE: dict[str, Any] = CHILLED_PLAN_EXAMPLE | {
+    "refrigeration": {"strategy": "optimal", "objective": "energy"}
+}
 
 
 #: The request examples of /v1/plans and /v1/fleet-plans as Swagger shows them: name →
@@ -269,6 +274,10 @@ PLAN_EXAMPLES: dict[str, tuple[str, dict[str, Any]]] = {
         CHILLED_PLAN_EXAMPLE,
     ),
     "vienna-8-stops-frozen": ("The morning round with frozen food", FROZEN_PLAN_EXAMPLE),
+    "vienna-8-stops-chilled-dairy-optimal": (
+        "The chilled round with the refrigeration unit's optimal schedule",
+        OPTIMAL_PLAN_EXAMPLE,
+    ),
 }
 FLEET_EXAMPLES: dict[str, tuple[str, dict[str, Any]]] = {
     "vienna-two-vans": (
@@ -311,10 +320,18 @@ def describe(answer: dict[str, Any]) -> str:
         else f" The goods between {chain['product_min_c']:.1f} and {chain['product_max_c']:.1f} "
         f"°C: the cold chain {chain['verdict']}."
     )
+    unit = answer.get("refrigeration") or {}
+    strategy = (
+        f" The unit's optimal schedule: {unit['battery_kwh']:.2f} kWh from the battery against "
+        f"the thermostat's {unit['thermostat_battery_kwh']:.2f}, {unit['grid_kwh']:.2f} from "
+        "the grid pre-cooling at the depot."
+        if unit.get("strategy") == "optimal"
+        else ""
+    )
     return (
         f"{energy['total']:.1f} kWh in all ({energy['refrigeration']:.1f} of them for the "
         f"refrigeration) on a {battery['usable_capacity_kwh']:g} kWh battery; {charged}; back "
-        f"at {back}, its lowest charge {battery['min_soc']:.0%}.{goods}"
+        f"at {back}, its lowest charge {battery['min_soc']:.0%}.{goods}{strategy}"
     )
 
 

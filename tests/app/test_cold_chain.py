@@ -335,3 +335,32 @@ def test_a_shortest_run_longer_than_the_day_is_a_422(client):
     answer = client.post("/v1/simulate", json=body)
     assert named(answer, body) == ["cargo_box.min_on_minutes"]
     assert "shortest run of 120 min" in answer.text
+
+
+def test_the_receding_horizon_re_plans_the_strategy_from_the_state_the_van_reports(client):
+    # under way, the door has left the air at 9 °C and the goods at 5.4 °C: the rest of the
+    # day is planned from there — no pre-cooling (the van is not at the depot), the air
+    # brought down from 9 °C and the goods kept inside dairy's band
+    state = {
+        "lat": 48.2006,
+        "lon": 16.3862,
+        "time": "2026-07-15T10:30:00+02:00",
+        "soc": 0.7,
+        "box_temperature_c": 9.0,
+        "product_temperature_c": 5.4,
+    }
+    body = PLAN_EXAMPLE | {
+        "cargo_box": DYNAMIC | {"product": "chilled-dairy"},
+        "start_state": state,
+        "stops": PLAN_EXAMPLE["stops"][1:],
+        "refrigeration": {"strategy": "optimal"},
+    }
+    answer = client.post("/v1/plans", json=body)
+    assert answer.status_code == 200, answer.text[:500]
+    data = answer.json()
+    rf = data["refrigeration"]
+    assert rf["grid_kwh"] == 0.0 and rf["battery_kwh"] < rf["thermostat_battery_kwh"]
+    assert rf["schedule"][0]["start"] == state["time"]
+    assert check_agrees(data)["verdict"] == "holds"
+    assert data["cold_chain"]["product_max_c"] <= 6.0
+    assert data["stops"][0]["air_temperature_c"]["arrival"] < 9.0
