@@ -83,6 +83,13 @@ class Settings(BaseSettings):
         description="Most samples, over all trips, a synchronous calibration fits (28 h at "
         "1 Hz, some ten seconds of work); beyond, a 413 points to jobs, which have no such bound.",
     )
+    far_stop_km: float = Field(
+        300.0,
+        gt=0,
+        le=20_040,
+        description="A stop farther than this from the depot (great circle) is planned with a "
+        "warning naming it: coordinates mistyped or swapped look like this [km].",
+    )
     max_time_limit_s: float = Field(
         120.0,
         gt=0,

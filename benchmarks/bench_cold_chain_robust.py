@@ -48,7 +48,7 @@ from core.physics.cold_chain import (
     follow,
     plan_setpoints,
 )
-from core.physics.strategy import GRID_S, GRID_WEIGHT
+from core.physics.strategy import GRID_WEIGHT
 
 #: Replays of each day (``COLDROUTE_BENCH_REPLAYS`` to change).
 REPLAYS = int(os.environ.get("COLDROUTE_BENCH_REPLAYS", "1000"))
@@ -216,14 +216,14 @@ def offline_gap(day: BoxDay) -> tuple[float, float]:
     cost when followed by the physics, in the strategy's measure: the battery's kWh and the
     grid's at :data:`core.physics.strategy.GRID_WEIGHT` (pre-cooling, plugged-in spells)."""
 
-    def followed(grid_s: float) -> float:
+    def followed(grid_s: float | None) -> float:
         box, outside, payload = day.box, day.outside, day.payload_kg
         plan = plan_setpoints(box, outside, payload, 1.0, day.start_c, day.run, grid_s)
         power = follow(box, outside, payload, 1.0, plan).power_w
         weight = 1.0 - (1.0 - GRID_WEIGHT) * day.plugged
         return (float((power * weight).sum()) + GRID_WEIGHT * plan.precool_grid_j) / JOULES_PER_KWH
 
-    return followed(GRID_S), followed(BOX_STEP_S)
+    return followed(None), followed(BOX_STEP_S)  # the plan's own grid, and the physics'
 
 
 def main() -> None:

@@ -3,9 +3,11 @@ the answer."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from app import connectors
 from app.operations.answers import attribution, energy
-from app.operations.limits import check_fleet_size, search_limits
+from app.operations.limits import check_fleet_size, far_stops, search_limits
 from app.operations.plan import plan_response
 from app.operations.vans import van_of
 from app.schemas.fleet import (
@@ -56,11 +58,12 @@ def check_fleet_plan(request: FleetPlanRequest, settings: Settings) -> None:
 
 def run_fleet_plan(request: FleetPlanRequest, settings: Settings) -> FleetResult:
     """Plan the fleet's day with the configured road router and weather service."""
-    return plan_fleet(
+    result = plan_fleet(
         fleet_problem(request, settings),
         connectors.router(settings),
         connectors.weather_service(settings),
     )
+    return replace(result, warnings=[*far_stops(request, settings), *result.warnings])
 
 
 def fleet_response(

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from app.settings import Settings
 from core.exceptions import ServerLimitError
 from core.planning.model import WORK_SHARE, FleetFields, PlanFields, RoundFields
+from core.routing.geo import great_circle_m
 
 
 def check_round(request: RoundFields, settings: Settings) -> None:
@@ -35,3 +38,17 @@ def search_limits(request: PlanFields | FleetFields, settings: Settings) -> dict
     requested_s = request.time_limit_s
     work_s = request.work_s if request.work_s is not None else WORK_SHARE * requested_s
     return {"time_limit_s": min(requested_s, settings.max_time_limit_s), "work_s": work_s}
+
+
+def far_stops(request: RoundFields, settings: Settings) -> list[str]:
+    """A warning for each stop farther from the depot than the server's ``far_stop_km``."""
+    places = [request.depot, *request.stops]
+    lat = np.array([p.lat for p in places], dtype=float)
+    lon = np.array([p.lon for p in places], dtype=float)
+    away_km = great_circle_m(lat, lon)[0, 1:] / 1000.0
+    return [
+        f"stops[{k}] ('{stop.id}') is {away_km[k]:,.0f} km from the depot (more than "
+        f"{settings.far_stop_km:g} km): check its coordinates (lat and lon swapped?)"
+        for k, stop in enumerate(request.stops)
+        if away_km[k] > settings.far_stop_km
+    ]

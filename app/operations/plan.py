@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 from app import connectors
 from app.operations.answers import attribution, battery, box, energy, weather
-from app.operations.limits import check_round, search_limits
+from app.operations.limits import check_round, far_stops, search_limits
 from app.operations.vans import van_of
 from app.schemas.base import (
     ColdChainOut,
@@ -53,11 +54,12 @@ def check_plan(request: PlanRequest, settings: Settings) -> None:
 
 def run_plan(request: PlanRequest, settings: Settings) -> PlanResult:
     """Plan a round with the configured road router and weather service."""
-    return plan(
+    result = plan(
         plan_problem(request, settings),
         connectors.router(settings),
         connectors.weather_service(settings),
     )
+    return replace(result, warnings=[*far_stops(request, settings), *result.warnings])
 
 
 def plan_response(

@@ -1,11 +1,14 @@
-"""The plan viewer (/viewer): one page and its script and style, served by the service itself
-(nothing from another host but the configured map tiles)."""
+"""The plan viewer (/viewer): one page, its script and style and the map and chart libraries
+vendored beside them (app/viewer/vendor: Leaflet, Leaflet.markercluster, uPlot, each with its
+licence), served by the service itself — nothing from another host but the configured map
+tiles."""
 
 from __future__ import annotations
 
 import html
 from functools import cache
 from importlib.resources import files
+from importlib.resources.abc import Traversable
 from urllib.parse import urlsplit
 
 from fastapi import APIRouter, Response
@@ -20,12 +23,31 @@ POLICY = (
     "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
     "img-src 'self' data: {tiles}; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"
 )
-ASSETS = {"viewer.js": "text/javascript", "viewer.css": "text/css"}
+#: The media type of each kind of file the viewer serves.
+MEDIA_TYPES = {".js": "text/javascript", ".css": "text/css", ".png": "image/png"}
+
+
+def _walk(folder: Traversable, prefix: str = "") -> dict[str, Traversable]:
+    found: dict[str, Traversable] = {}
+    for entry in folder.iterdir():
+        name = f"{prefix}{entry.name}"
+        if entry.is_dir():
+            found |= _walk(entry, f"{name}/")
+        elif any(name.endswith(suffix) for suffix in MEDIA_TYPES) or entry.name == "LICENSE":
+            found[name] = entry
+    return found
 
 
 @cache
-def _asset(name: str) -> str:
-    return files("app.viewer").joinpath(name).read_text(encoding="utf-8")
+def _assets() -> dict[str, Traversable]:
+    """Every file the viewer may serve by its path under /viewer/static/ — the page's own
+    script and style and the vendored libraries with their licences; nothing else."""
+    return _walk(files("app.viewer"))
+
+
+@cache
+def _page() -> str:
+    return files("app.viewer").joinpath("index.html").read_text(encoding="utf-8")
 
 
 def _tile_origin(tile_url: str) -> str:
@@ -38,7 +60,7 @@ def _tile_origin(tile_url: str) -> str:
 @router.get("/viewer")
 def viewer(settings: SettingsDep) -> Response:
     """The page: the tiles' URL and credit in its body's data attributes."""
-    page = _asset("index.html").format(
+    page = _page().format(
         tile_url=html.escape(settings.tile_url, quote=True),
         tile_attribution=html.escape(settings.tile_attribution, quote=True),
     )
@@ -50,9 +72,11 @@ def viewer(settings: SettingsDep) -> Response:
     )
 
 
-@router.get("/viewer/static/{name}")
+@router.get("/viewer/static/{name:path}")
 def asset(name: str) -> Response:
-    if name not in ASSETS:
+    found = _assets().get(name)
+    if found is None:
         shown = name if len(name) <= 64 else f"{name[:64]}… ({len(name):,} characters)"
         raise HTTPException(404, f"no viewer asset {shown!r}")
-    return Response(_asset(name), media_type=ASSETS[name], headers={"Cache-Control": "no-cache"})
+    media = next((t for s, t in MEDIA_TYPES.items() if name.endswith(s)), "text/plain")
+    return Response(found.read_bytes(), media_type=media, headers={"Cache-Control": "no-cache"})

@@ -1,22 +1,41 @@
 // coldroute plan viewer: the stops from a CSV (or a pasted request), planned by the service,
-// drawn as hand-made SVG (no library, nothing from another host but the optional map tiles).
+// drawn with Leaflet (the map, its markers clustered) and uPlot (the charts), both vendored
+// into the service: nothing from another host but the optional map tiles.
+/* global L, uPlot */
 "use strict";
 
-const SVG = "http://www.w3.org/2000/svg";
 const CONSUMERS = ["traction", "auxiliaries", "cabin", "refrigeration"];
 const CONSUMER_COLOURS = {
-  traction: "#4c78a8", auxiliaries: "#f58518", cabin: "#54a24b", refrigeration: "#e45756",
+  traction: "#4c78a8", auxiliaries: "#c4570a", cabin: "#3b7d32", refrigeration: "#c03a3a",
 };
 const ROUTE_COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
   "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"];
+// The columns the CSV reads; any other column is kept as it is and shown (address, notes…).
 const CSV_COLUMNS = ["id", "lat", "lon", "service_min", "door_min", "kg", "window_start",
-  "window_end"];
+  "window_end", "product"];
 // Larger requests go as a job: polled, with progress, and reopened by /viewer?job=<id>.
 const SYNC_MAX_STOPS = 60;
 const SYNC_MAX_TIME_LIMIT_S = 10;
+// A stop farther than this from the depot is flagged before planning (the service warns too).
+const FAR_STOP_KM = 300;
+// Stop markers nearer each other than this on screen are clustered [px] (a marker is 22 px).
+const CLUSTER_RADIUS_PX = 26;
+// Shaded spans in the charts: what the van does then, and its colour.
+const SPANS = {
+  charge: ["charging", "rgba(60, 160, 60, 0.22)"],
+  break: ["driver's break", "rgba(123, 97, 196, 0.2)"],
+  reload: ["reloading at the depot", "rgba(230, 140, 30, 0.22)"],
+  door: ["door open at a stop", "rgba(120, 120, 120, 0.2)"],
+};
 
-const state = { request: null, endpoint: null, answer: null, routes: [], places: {} };
+const state = {
+  request: null, endpoint: null, answer: null, routes: [], places: {}, extras: {},
+  columns: [], charts: [],
+};
 let polling = null;
+let map = null;
+let planLayer = null;
+let tiles = null;
 
 function $(id) { return document.getElementById(id); }
 
@@ -27,30 +46,59 @@ function el(tag, attributes = {}, text = null) {
   return node;
 }
 
-function svg(tag, attributes = {}, text = null) {
-  const node = document.createElementNS(SVG, tag);
-  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, String(value));
-  if (text !== null) node.textContent = text;
-  return node;
+// ---------------------------------------------------------------- numbers and times
+
+function fixed(x, digits) {
+  // No negative zero: "-0.00" reads as a loss where there is none.
+  const text = x.toFixed(digits);
+  return Number(text) === 0 ? (0).toFixed(digits) : text;
+}
+function percent(x) { return `${fixed(100 * x, 0)} %`; }
+function kwh(x) { return `${fixed(x, 1)} kWh`; }
+function km(m) { return `${fixed(m / 1000, 1)} km`; }
+function celsius(x) { return x === null || x === undefined ? "" : `${fixed(x, 1)} °C`; }
+function minutes(s) { return `${fixed(s / 60, 0)} min`; }
+function localTime(iso) { return iso ? iso.slice(11, 16) : ""; }
+
+function offsetSeconds(iso) {
+  // The UTC offset an ISO time carries (the plan's own zone), in seconds.
+  const match = /([+-])(\d\d):?(\d\d)$/.exec(iso);
+  if (!match) return 0;
+  return (match[1] === "-" ? -1 : 1) * (Number(match[2]) * 3600 + Number(match[3]) * 60);
 }
 
-function titled(node, text) {
-  node.appendChild(svg("title", {}, text));
-  return node;
+function wallClock(iso) {
+  // The plan's local wall-clock time as seconds of a UTC clock: the charts read it in UTC, so
+  // they show the plan's local time whatever the browser's zone.
+  return Date.parse(iso) / 1000 + offsetSeconds(iso);
+}
+
+function distanceKm(a, b) {
+  const rad = Math.PI / 180;
+  const h = Math.sin(((b.lat - a.lat) * rad) / 2) ** 2 +
+    Math.cos(a.lat * rad) * Math.cos(b.lat * rad) * Math.sin(((b.lon - a.lon) * rad) / 2) ** 2;
+  return 2 * 6371.0088 * Math.asin(Math.min(1, Math.sqrt(h)));
 }
 
 // ---------------------------------------------------------------- messages
 
 function showError(message) {
   $("errors").appendChild(el("li", { class: "error", "data-testid": "error" }, message));
+  $("messages").scrollIntoView({ block: "nearest" });
+}
+
+function flag(message) {
+  $("flags").appendChild(el("li", { class: "warning", "data-testid": "flag" }, message));
 }
 
 function clearMessages() {
   $("errors").replaceChildren();
+  $("flags").replaceChildren();
   $("status").textContent = "";
 }
 
 function showProblem(problem, status) {
+  clearPlan();
   if (problem && Array.isArray(problem.errors) && problem.errors.length) {
     for (const entry of problem.errors) showError(`${entry.field}: ${entry.message}`);
   } else if (problem && problem.detail) {
@@ -77,33 +125,75 @@ async function api(method, path, body) {
   return { ok: response.ok, status: response.status, data };
 }
 
+const vans = { options: [] };
+
 async function loadVans() {
-  const select = $("van-kind");
-  const chosen = select.value;
-  select.replaceChildren();
   const presets = await api("GET", "/v1/presets");
   const profiles = await api("GET", "/v1/vehicle-profiles");
   if (!presets.ok) {
-    select.appendChild(el("option", { value: "preset:paper-generic" }, "paper-generic"));
+    vans.options = [["Presets", [["preset:paper-generic", "paper-generic"]]]];
     if (presets.status === 401) $("status").textContent = "Enter the API key to list the vans.";
-    return;
-  }
-  const group = el("optgroup", { label: "Presets" });
-  for (const preset of presets.data.presets) {
-    group.appendChild(el("option", { value: `preset:${preset.name}` }, preset.name));
-  }
-  select.appendChild(group);
-  if (profiles.ok && profiles.data.profiles.length) {
-    const own = el("optgroup", { label: "Vehicle profiles" });
-    for (const profile of profiles.data.profiles) {
-      own.appendChild(el("option", { value: `profile:${profile.name}` }, profile.name));
+  } else {
+    // A preset that carries no payload (a reference car) cannot make deliveries.
+    const carriers = presets.data.presets.filter((p) => p.payload_kg > 0);
+    vans.options = [["Presets", carriers.map((p) => [`preset:${p.name}`,
+      `${p.name} (${fixed(p.battery.usable_capacity_kwh, 0)} kWh, ${fixed(p.payload_kg, 0)} kg)`])]];
+    if (profiles.ok && profiles.data.profiles.length) {
+      vans.options.push(["Vehicle profiles", profiles.data.profiles.map((p) => [`profile:${p.name}`, p.name])]);
     }
-    select.appendChild(own);
   }
-  if (chosen && [...select.options].some((o) => o.value === chosen)) select.value = chosen;
-  else if ([...select.options].some((o) => o.value === "preset:ev-van-3.5t-reefer")) {
-    select.value = "preset:ev-van-3.5t-reefer";
+  for (const select of document.querySelectorAll("select.van-kind")) fillVanKinds(select);
+}
+
+function fillVanKinds(select) {
+  const chosen = select.value;
+  select.replaceChildren();
+  for (const [label, options] of vans.options) {
+    const group = el("optgroup", { label });
+    for (const [value, text] of options) group.appendChild(el("option", { value }, text));
+    select.appendChild(group);
   }
+  const values = [...select.options].map((o) => o.value);
+  if (select.dataset.chosen && values.includes(chosen)) select.value = chosen;
+  else if (values.includes("preset:ev-van-3.5t-reefer")) select.value = "preset:ev-van-3.5t-reefer";
+}
+
+function addVanRow(first = false) {
+  // One kind of van: its model, how many, its battery and payload, its driver's shift.
+  const row = el("div", { class: "van-row", "data-testid": "van-row" });
+  const field = (label, input) => {
+    const wrap = el("label");
+    wrap.append(el("span", {}, label), input);
+    return wrap;
+  };
+  const kind = el("select", { class: "van-kind" });
+  kind.addEventListener("change", () => { kind.dataset.chosen = "yes"; });
+  const count = el("input", { type: "number", class: "van-count", min: "1", max: "100", value: "2" });
+  const battery = el("input", { type: "number", class: "battery-kwh", min: "1", step: "any", placeholder: "the van's" });
+  const payload = el("input", { type: "number", class: "payload-kg", min: "0", step: "any", placeholder: "the van's" });
+  const start = el("input", { type: "time", class: "shift-start", value: "06:30", "aria-label": "Shift start" });
+  const end = el("input", { type: "time", class: "shift-end", value: "16:30", "aria-label": "Shift end" });
+  if (first) {
+    kind.id = "van-kind";
+    count.id = "van-count";
+    count.dataset.testid = "van-count";
+    battery.id = "battery-kwh";
+    payload.id = "payload-kg";
+    start.id = "shift-start";
+    end.id = "shift-end";
+  }
+  const shift = el("label");
+  shift.append(el("span", {}, "Shift"), start, " – ", end);
+  row.append(field("Van", kind), field("How many", count), field("Battery [kWh]", battery),
+    field("Payload [kg]", payload), shift);
+  if (!first) {
+    const remove = el("button", { type: "button", class: "secondary" }, "Remove");
+    remove.addEventListener("click", () => row.remove());
+    row.appendChild(remove);
+  }
+  $("van-rows").appendChild(row);
+  fillVanKinds(kind);
+  return row;
 }
 
 // ---------------------------------------------------------------- CSV of stops
@@ -126,22 +216,32 @@ function splitCsvLine(line, delimiter) {
   return cells.map((x) => x.trim());
 }
 
-function parseStopsCsv(text) {
+function clockOf(raw) {
+  // H:MM, HH:MM or HH:MM:SS as the service's HH:MM (seconds must be 00), or null.
+  const match = /^(\d{1,2}):([0-5]\d)(?::([0-5]\d))?$/.exec(raw);
+  if (!match || Number(match[1]) > 23 || (match[3] && match[3] !== "00")) return null;
+  return `${match[1].padStart(2, "0")}:${match[2]}`;
+}
+
+function parseStopsCsv(text, depot) {
   const lines = text.replace(/^\ufeff/, "").split(/\r\n|\n|\r/);
   while (lines.length && !lines[lines.length - 1].trim()) lines.pop();
   if (!lines.length || !lines[0].trim()) throw new CsvError("The CSV is empty: it needs a header row.");
   const delimiter = (lines[0].match(/;/g) || []).length > (lines[0].match(/,/g) || []).length ? ";" : ",";
-  const header = splitCsvLine(lines[0], delimiter).map((h) => h.toLowerCase());
-  for (const name of header) {
-    if (!CSV_COLUMNS.includes(name)) {
-      throw new CsvError(`Header row, column “${name}”: not a column of this CSV (${CSV_COLUMNS.join(",")}).`);
-    }
-  }
+  const names = splitCsvLine(lines[0], delimiter);
+  const header = names.map((h) => h.toLowerCase());
   for (const needed of ["id", "lat", "lon"]) {
     if (!header.includes(needed)) throw new CsvError(`Header row: the column “${needed}” is missing.`);
   }
+  header.forEach((name, k) => {
+    if (!name) throw new CsvError(`Header row, column ${k + 1}: it has no name.`);
+    if (header.indexOf(name) !== k) throw new CsvError(`Header row: the column “${names[k]}” appears twice.`);
+  });
+  const kept = names.filter((_, k) => !CSV_COLUMNS.includes(header[k]));
   const stops = [];
+  const extras = {};
   const seen = new Set();
+  const products = new Set();
   for (let i = 1; i < lines.length; i += 1) {
     if (!lines[i].trim()) continue;
     const row = stops.length + 1;
@@ -168,10 +268,11 @@ function parseStopsCsv(text) {
     const clock = (column) => {
       const raw = value[column] || "";
       if (!raw) return null;
-      if (!/^([01]\d|2[0-3]):[0-5]\d$/.test(raw)) {
-        throw new CsvError(`${where(column)}: “${raw}” is not a time of day HH:MM.`);
+      const time = clockOf(raw);
+      if (time === null) {
+        throw new CsvError(`${where(column)}: “${raw}” is not a time of day (H:MM, HH:MM or HH:MM:SS).`);
       }
-      return raw;
+      return time;
     };
     const id = value.id;
     if (!id) throw new CsvError(`${where("id")}: empty; every stop needs an id.`);
@@ -185,6 +286,17 @@ function parseStopsCsv(text) {
       door_open_s: 60 * number("door_min", 0, 1440, 2),
       delivery_kg: number("kg", 0, 40000, 0),
     };
+    if (depot) {
+      const away = distanceKm(depot, stop);
+      const swapped = distanceKm(depot, { lat: stop.lon, lon: stop.lat });
+      if (away > FAR_STOP_KM && swapped <= FAR_STOP_KM && Math.abs(stop.lon) <= 90) {
+        throw new CsvError(`Row ${row} (line ${i + 1}), “${id}”: lat ${stop.lat} and lon ${stop.lon} look swapped ` +
+          `— ${fixed(away, 0)} km from the depot as given, ${fixed(swapped, 0)} km swapped.`);
+      }
+      if (away > FAR_STOP_KM) {
+        flag(`Row ${row} (line ${i + 1}), “${id}”: ${fixed(away, 0)} km from the depot — check its coordinates.`);
+      }
+    }
     const start = clock("window_start");
     const end = clock("window_end");
     if ((start === null) !== (end === null)) {
@@ -194,49 +306,83 @@ function parseStopsCsv(text) {
       if (end <= start) throw new CsvError(`${where("window_end")}: ${end} is not after ${start}.`);
       stop.time_windows = [{ start, end }];
     }
+    if (value.product) products.add(value.product);
+    extras[id] = Object.fromEntries(names.map((n, k) => [n, cells[k]]).filter(([n]) => kept.includes(n)));
     stops.push(stop);
   }
   if (!stops.length) throw new CsvError("The CSV has a header row but no stop.");
-  return stops;
+  if (products.size > 1) {
+    throw new CsvError(`Column “product”: one box carries one product; the rows name ${[...products].join(", ")}.`);
+  }
+  return { stops, extras, columns: kept, product: [...products][0] || null };
 }
 
-async function readStopsFile() {
-  const file = $("stops-csv").files[0];
-  if (!file) throw new CsvError("Choose a CSV file of stops, or paste a request.");
-  return parseStopsCsv(await file.text());
-}
-
-function formRequest(stops) {
+function depotOf() {
   const depot = $("depot").value.split(/[,;\s]+/).filter(Boolean).map(Number);
-  if (depot.length !== 2 || depot.some((x) => !Number.isFinite(x))) {
+  if (depot.length !== 2 || depot.some((x) => !Number.isFinite(x)) || Math.abs(depot[0]) > 90 || Math.abs(depot[1]) > 180) {
     throw new CsvError("Depot: give its latitude and longitude, e.g. 48.1703, 16.4207.");
   }
-  const count = Number($("van-count").value);
-  if (!Number.isInteger(count) || count < 1 || count > 100) {
-    throw new CsvError("How many vans: a whole number from 1 to 100.");
-  }
-  if (!$("date").value) throw new CsvError("Date: choose the day to plan.");
-  const [kind, name] = $("van-kind").value.split(/:(.*)/s);
+  return { lat: depot[0], lon: depot[1] };
+}
+
+async function readStopsFile(depot) {
+  const file = $("stops-csv").files[0];
+  if (!file) throw new CsvError("Choose a CSV file of stops, or paste a request.");
+  return parseStopsCsv(await file.text(), depot);
+}
+
+function formVehicles(cargoBox, refrigeration) {
   const vehicles = [];
-  for (let k = 1; k <= count; k += 1) {
-    const van = {
-      id: `van-${k}`,
-      vehicle: kind === "profile" ? { profile: name } : { preset: name || "paper-generic" },
-      shift_start: $("shift-start").value,
-      shift_end: $("shift-end").value,
-    };
-    if ($("battery-kwh").value) van.battery = { usable_capacity_kwh: Number($("battery-kwh").value) };
-    if ($("payload-kg").value) van.payload_kg = Number($("payload-kg").value);
-    vehicles.push(van);
+  let n = 0;
+  for (const row of document.querySelectorAll(".van-row")) {
+    const count = Number(row.querySelector(".van-count").value);
+    if (!Number.isInteger(count) || count < 1 || count > 100) {
+      throw new CsvError("How many vans: a whole number from 1 to 100 in each row.");
+    }
+    const [kind, name] = row.querySelector(".van-kind").value.split(/:(.*)/s);
+    const battery = row.querySelector(".battery-kwh").value;
+    const payload = row.querySelector(".payload-kg").value;
+    for (let k = 0; k < count; k += 1) {
+      n += 1;
+      const van = {
+        id: `van-${n}`,
+        vehicle: kind === "profile" ? { profile: name } : { preset: name || "paper-generic" },
+        shift_start: row.querySelector(".shift-start").value,
+        shift_end: row.querySelector(".shift-end").value,
+      };
+      if (battery) van.battery = { usable_capacity_kwh: Number(battery) };
+      if (payload) van.payload_kg = Number(payload);
+      if (cargoBox) van.cargo_box = cargoBox;
+      if (refrigeration) van.refrigeration = refrigeration;
+      vehicles.push(van);
+    }
   }
-  return {
+  if (vehicles.length > 100) throw new CsvError(`Vans: at most 100 in all, the rows ask for ${vehicles.length}.`);
+  return vehicles;
+}
+
+function formRequest(parsed, depot) {
+  if (!$("date").value) throw new CsvError("Date: choose the day to plan.");
+  const product = $("product").value || parsed.product;
+  const strategy = $("strategy").value;
+  if (strategy === "optimal" && !product) {
+    throw new CsvError("Unit: the optimal schedule keeps a product in its band — choose the product.");
+  }
+  // The optimal strategy plans a unit of finite capacity: the dynamic box.
+  const cargoBox = product ? { product, mode: "dynamic" } : null;
+  const body = {
     date: $("date").value,
     timezone: $("timezone").value || null,
-    depot: { id: "depot", lat: depot[0], lon: depot[1] },
-    stops,
-    vehicles,
+    depot: { id: "depot", lat: depot.lat, lon: depot.lon },
+    stops: parsed.stops,
+    vehicles: formVehicles(cargoBox, strategy === "optimal" ? { strategy } : null),
     time_limit_s: Number($("time-limit").value) || 3,
   };
+  const low = $("t-min").value;
+  const high = $("t-max").value;
+  if ((low === "") !== (high === "")) throw new CsvError("Weather: give both the low and the high, or neither.");
+  if (low !== "") body.weather = { t_min_c: Number(low), t_max_c: Number(high) };
+  return body;
 }
 
 // ---------------------------------------------------------------- planning
@@ -247,6 +393,8 @@ async function plan(event) {
   stopPolling();
   let body;
   const pasted = $("request-json").value.trim();
+  state.extras = {};
+  state.columns = [];
   try {
     if (pasted) {
       try { body = JSON.parse(pasted); } catch (error) {
@@ -256,10 +404,14 @@ async function plan(event) {
         throw new CsvError("The pasted request needs its stops[] (the body of /v1/plans or /v1/fleet-plans).");
       }
     } else {
-      body = formRequest(await readStopsFile());
+      const depot = depotOf();
+      const parsed = await readStopsFile(depot);
+      body = formRequest(parsed, depot);
+      state.extras = parsed.extras;
+      state.columns = parsed.columns;
     }
   } catch (error) {
-    if (error instanceof CsvError) { showError(error.message); return; }
+    if (error instanceof CsvError) { clearPlan(); showError(error.message); return; }
     throw error;
   }
   const endpoint = Array.isArray(body.vehicles) ? "fleet-plans" : "plans";
@@ -337,11 +489,6 @@ function follow(jobId, request, endpoint) {
 
 // ---------------------------------------------------------------- the answer
 
-function localTime(iso) { return iso ? iso.slice(11, 16) : ""; }
-function percent(x) { return `${(100 * x).toFixed(0)} %`; }
-function kwh(x) { return `${x.toFixed(1)} kWh`; }
-function km(m) { return `${(m / 1000).toFixed(1)} km`; }
-
 function routesOf(endpoint, answer) {
   if (endpoint === "plans") return [{ ...answer, vehicle_id: "van" }];
   return answer.routes;
@@ -354,7 +501,24 @@ function vanOf(request, vehicleId) {
   return request || {};
 }
 
+function clearPlan() {
+  // A failed request leaves no earlier plan on screen to be taken for its answer.
+  state.request = null;
+  state.answer = null;
+  state.routes = [];
+  for (const chart of state.charts) chart.destroy();
+  state.charts = [];
+  if (planLayer) planLayer.clearLayers();
+  $("routes").replaceChildren();
+  $("fleet-card").hidden = true;
+  $("assumptions-card").hidden = true;
+  $("export-csv").disabled = true;
+  $("export-geojson").disabled = true;
+  if (map) map.legend.update();
+}
+
 function show(request, endpoint, answer) {
+  clearPlan();
   state.request = request;
   state.endpoint = endpoint;
   state.answer = answer;
@@ -377,215 +541,271 @@ function show(request, endpoint, answer) {
   }
   drawMap();
   drawFleet();
+  drawAssumptions();
   drawRoutes();
   $("export-csv").disabled = false;
   $("export-geojson").disabled = false;
 }
 
 function unassignedOf() {
-  return state.endpoint === "plans" ? [] : (state.answer.unassigned || []);
+  return state.endpoint === "plans" || !state.answer ? [] : (state.answer.unassigned || []);
 }
+
+function colourOf(index) { return ROUTE_COLOURS[index % ROUTE_COLOURS.length]; }
 
 // ---------------------------------------------------------------- the map
 
-function mercator(lat, lon) {
-  const s = Math.sin((Math.max(Math.min(lat, 85), -85) * Math.PI) / 180);
-  return [(lon + 180) / 360, 0.5 - Math.log((1 + s) / (1 - s)) / (4 * Math.PI)];
+function createMap() {
+  map = L.map("map", { zoomSnap: 0.25, keyboard: true, maxZoom: 19 });
+  map.setView([48.2, 16.37], 11);
+  const url = document.body.dataset.tileUrl;
+  if (url) {
+    tiles = L.tileLayer(url, {
+      attribution: document.body.dataset.tileAttribution || "", subdomains: "abc", maxZoom: 19,
+    });
+    // A tile that fails (offline, server down) takes the layer away: the plan's own legs on
+    // the plain background, and a note — never a field of broken images.
+    tiles.on("tileerror", () => {
+      if (!map.hasLayer(tiles)) return;
+      map.removeLayer(tiles);
+      mapNote(`The map tiles could not be loaded from ${new URL(url.replace("{s}", "a")).host}: ` +
+        "the plan's own legs on a plain background.");
+    });
+    tiles.addTo(map);
+  } else {
+    mapNote("No map tiles are configured (COLDROUTE_TILE_URL): the plan's own legs on a plain background.");
+  }
+  const scale = L.control.scale({ imperial: false, maxWidth: 160 }).addTo(map);
+  scale.getContainer().dataset.testid = "scale-bar";
+  planLayer = L.featureGroup().addTo(map);
+  map.legend = legendControl().addTo(map);
+}
+
+function mapNote(text) {
+  const note = $("map-note");
+  note.textContent = text;
+  note.hidden = false;
+  $("map").classList.add("no-tiles");
+}
+
+function legendControl() {
+  const control = L.control({ position: "topright" });
+  control.onAdd = () => {
+    const box = el("div", { class: "map-legend", "data-testid": "map-legend" });
+    box.hidden = true;
+    control.box = box;
+    return box;
+  };
+  control.update = () => {
+    const box = control.box;
+    box.replaceChildren();
+    if (!state.routes.length) { box.hidden = true; return; }
+    box.hidden = false;
+    box.appendChild(el("b", {}, "Legend"));
+    state.routes.forEach((route, r) => {
+      const item = el("button", { type: "button", class: "legend-route", "data-vehicle": route.vehicle_id });
+      const swatch = el("span", { class: "swatch" });
+      swatch.style.background = colourOf(r);
+      item.append(swatch, `${route.vehicle_id}: ${route.stops.length} stops`);
+      item.addEventListener("mouseenter", () => highlight(route.vehicle_id));
+      item.addEventListener("focus", () => highlight(route.vehicle_id));
+      item.addEventListener("mouseleave", () => highlight(null));
+      item.addEventListener("blur", () => highlight(null));
+      box.appendChild(item);
+    });
+    const symbols = [["depot-icon", "", "depot"], ["charge-icon", "⚡", "charge"],
+      ["break-icon", "☕", "driver's break"], ["reload-icon", "↺", "reload at the depot"],
+      ["unassigned-icon", "✕", "not served"]];
+    for (const [cls, text, label] of symbols) {
+      const row = el("div");
+      row.append(el("span", { class: `legend-symbol ${cls}` }, text), ` ${label}`);
+      box.appendChild(row);
+    }
+    if (state.routes.some((route) => route.legs.some((leg) => !(leg.geometry && leg.geometry.coordinates)))) {
+      const row = el("div");
+      row.append(el("span", { class: "legend-dash" }), " straight line: no road geometry");
+      box.appendChild(row);
+    }
+  };
+  return control;
 }
 
 function routeLine(route) {
+  // The route's road geometry where the router gave it; else straight between its places.
   const points = [];
+  let straight = false;
   for (const leg of route.legs) {
     const line = leg.geometry && leg.geometry.coordinates;
     if (line && line.length > 1) {
       for (const [lon, lat] of line) points.push([lat, lon]);
     } else {
+      straight = true;
       for (const id of [leg.from_id, leg.to_id]) {
         const place = state.places[id];
         if (place) points.push([place.lat, place.lon]);
       }
     }
   }
-  return points;
+  return { points, straight };
 }
 
-function niceLength(metres) {
-  const power = 10 ** Math.floor(Math.log10(metres));
-  for (const step of [5, 2, 1]) if (step * power <= metres) return step * power;
-  return power;
+function icon(cls, text, attributes, colour) {
+  const node = el("span", { class: `map-icon ${cls}`, ...attributes }, text);
+  if (colour) node.style.borderColor = colour;
+  return L.divIcon({ className: "map-icon-holder", html: node, iconSize: null });
+}
+
+function marker(lat, lon, divIcon, tooltip, vehicleId) {
+  // tooltip: HTML with the client's texts escaped, lines split by newlines.
+  const m = L.marker([lat, lon], { icon: divIcon, keyboard: true });
+  m.bindTooltip(tooltip.replace(/\n/g, "<br>"), { direction: "top" });
+  const label = new DOMParser().parseFromString(tooltip, "text/html").body.textContent.replace(/\n/g, "; ");
+  m.on("add", () => {
+    m.getElement().setAttribute("aria-label", label);
+    m.getElement().setAttribute("role", "button");
+  });
+  if (vehicleId) {
+    m.on("mouseover focus", () => highlight(vehicleId));
+    m.on("mouseout blur", () => highlight(null));
+  }
+  return m;
+}
+
+function escapeHtml(text) {
+  return String(text).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;");
 }
 
 function drawMap() {
-  const map = $("map");
-  map.replaceChildren();
-  const width = map.clientWidth || 900;
-  const height = map.clientHeight || 560;
-  map.setAttribute("viewBox", `0 0 ${width} ${height}`);
-  const lines = state.routes.map(routeLine);
-  const points = lines.flat();
-  for (const item of unassignedOf()) {
-    const place = state.places[item.id];
-    if (place) points.push([place.lat, place.lon]);
-  }
-  for (const route of state.routes) for (const c of route.charges || []) points.push([c.lat, c.lon]);
-  if (!points.length) return;
-  const projected = points.map(([lat, lon]) => mercator(lat, lon));
-  const xs = projected.map((p) => p[0]);
-  const ys = projected.map((p) => p[1]);
-  const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
-  const pad = 40;
-  const fit = Math.min((width - 2 * pad) / Math.max(x1 - x0, 1e-9), (height - 2 * pad) / Math.max(y1 - y0, 1e-9));
-  const zoom = Math.max(0, Math.min(18, Math.floor(Math.log2(fit / 256))));
-  const scale = 256 * 2 ** zoom;
-  const cx = ((x0 + x1) / 2) * scale - width / 2;
-  const cy = ((y0 + y1) / 2) * scale - height / 2;
-  const at = (lat, lon) => {
-    const [x, y] = mercator(lat, lon);
-    return [x * scale - cx, y * scale - cy];
-  };
-  map.appendChild(svg("rect", { x: 0, y: 0, width, height, fill: "#e8edf1" }));
-  const tiles = document.body.dataset.tileUrl;
-  if (tiles) {
-    const layer = svg("g", { "data-testid": "tiles" });
-    const count = 2 ** zoom;
-    for (let tx = Math.floor(cx / 256); tx <= Math.floor((cx + width) / 256); tx += 1) {
-      for (let ty = Math.floor(cy / 256); ty <= Math.floor((cy + height) / 256); ty += 1) {
-        if (ty < 0 || ty >= count) continue;
-        const wrapped = ((tx % count) + count) % count;
-        const href = tiles.replace("{z}", zoom).replace("{x}", wrapped).replace("{y}", ty)
-          .replace("{s}", "abc"[(wrapped + ty) % 3]);
-        layer.appendChild(svg("image", {
-          href, x: tx * 256 - cx, y: ty * 256 - cy, width: 256, height: 256,
-        }));
-      }
-    }
-    map.appendChild(layer);
-  }
-  state.routes.forEach((route, r) => {
-    const colour = ROUTE_COLOURS[r % ROUTE_COLOURS.length];
-    const path = lines[r].map(([lat, lon]) => at(lat, lon).map((v) => v.toFixed(1)).join(",")).join(" ");
-    map.appendChild(titled(svg("polyline", {
-      points: path, fill: "none", stroke: colour, "stroke-width": 3.5, "stroke-opacity": 0.85,
-      "stroke-linejoin": "round", "data-testid": "route-line", "data-vehicle": route.vehicle_id,
-    }), `${route.vehicle_id}: ${km(route.totals.distance_m)}, ${kwh(route.totals.energy_kwh.total)}`));
+  planLayer.clearLayers();
+  state.lines = {};
+  // Stops closer on screen than a marker's width are clustered (the cluster says how many;
+  // a click zooms in): numbers never overlap, at 7 stops or 700.
+  const stopsLayer = L.markerClusterGroup({
+    maxClusterRadius: CLUSTER_RADIUS_PX, disableClusteringAtZoom: 18, showCoverageOnHover: false,
   });
-  const depot = state.request && state.request.depot;
-  if (depot) {
-    const [x, y] = at(depot.lat, depot.lon);
-    map.appendChild(titled(svg("rect", {
-      x: x - 8, y: y - 8, width: 16, height: 16, fill: "#12344d", stroke: "#fff",
-      "stroke-width": 2, "data-testid": "depot-marker",
-    }), `Depot ${depot.id}`));
-  }
+  stopsLayer.addTo(planLayer);
+  state.stopsLayer = stopsLayer;
   state.routes.forEach((route, r) => {
-    const colour = ROUTE_COLOURS[r % ROUTE_COLOURS.length];
+    const colour = colourOf(r);
+    const { points, straight } = routeLine(route);
+    const line = L.polyline(points, {
+      color: colour, weight: 4, opacity: 0.85, dashArray: straight ? "8 6" : null,
+    }).addTo(planLayer);
+    line.bindTooltip(`${escapeHtml(route.vehicle_id)}: ${km(route.totals.distance_m)}, ${kwh(route.totals.energy_kwh.total)}`, { sticky: true });
+    const path = line.getElement();
+    path.setAttribute("data-testid", "route-line");
+    path.setAttribute("data-vehicle", route.vehicle_id);
+    path.setAttribute("data-points", String(points.length));
+    line.on("mouseover", () => highlight(route.vehicle_id));
+    line.on("mouseout", () => highlight(null));
+    state.lines[route.vehicle_id] = line;
     route.stops.forEach((stop, k) => {
       const place = state.places[stop.id];
       if (!place) return;
-      const [x, y] = at(place.lat, place.lon);
-      const window = (state.places[stop.id].time_windows || [])
-        .map((w) => `${w.start}–${w.end}`).join(", ") || "none";
-      const marker = svg("g", { "data-testid": "stop-marker", "data-stop": stop.id, "data-vehicle": route.vehicle_id });
-      marker.appendChild(svg("circle", { cx: x, cy: y, r: 9, fill: "#fff", stroke: colour, "stroke-width": 2.5 }));
-      marker.appendChild(svg("text", {
-        x, y: y + 3.5, "text-anchor": "middle", "font-size": 10, "font-weight": 700, fill: "#1d2733",
-      }, String(k + 1)));
-      titled(marker, `${route.vehicle_id} · ${k + 1}. ${stop.id}\narrival ${localTime(stop.arrival)}` +
-        `, window ${window}, departure ${localTime(stop.departure)}\nSoC ${percent(stop.soc_arrival)}` +
-        ` → ${percent(stop.soc_departure)}, door heat ${stop.door_heat_kwh.toFixed(2)} kWh`);
-      map.appendChild(marker);
+      const windows = (place.time_windows || []).map((w) => `${w.start}–${w.end}`).join(", ") || "none";
+      const extra = Object.entries(state.extras[stop.id] || {}).filter(([, v]) => v)
+        .map(([name, v]) => `\n${escapeHtml(name)}: ${escapeHtml(v)}`).join("");
+      const tooltip = `${escapeHtml(route.vehicle_id)} · ${k + 1}. ${escapeHtml(stop.id)}${extra}\n` +
+        `arrive ${localTime(stop.arrival)}, window ${windows}, leave ${localTime(stop.departure)}\n` +
+        `SoC ${percent(stop.soc_arrival)} → ${percent(stop.soc_departure)}`;
+      stopsLayer.addLayer(marker(place.lat, place.lon, icon("stop-icon", String(k + 1), {
+        "data-testid": "stop-marker", "data-stop": stop.id, "data-vehicle": route.vehicle_id,
+      }, colour), tooltip, route.vehicle_id));
     });
     for (const charge of route.charges || []) {
-      const [x, y] = at(charge.lat, charge.lon);
-      map.appendChild(titled(svg("path", {
-        d: `M${x - 3},${y - 11} L${x + 5},${y - 11} L${x},${y - 1} L${x + 6},${y - 1} L${x - 5},${y + 12} L${x - 1},${y + 2} L${x - 6},${y + 2} Z`,
-        fill: "#f2c200", stroke: "#5a4600", "stroke-width": 1, "data-testid": "charge-marker",
-      }), `${route.vehicle_id} charges at ${charge.charger_id} ${localTime(charge.arrive)}–` +
-        `${localTime(charge.depart)}: ${percent(charge.soc_before)} → ${percent(charge.soc_after)}`));
+      marker(charge.lat, charge.lon, icon("charge-icon", "⚡", { "data-testid": "charge-marker" }),
+        `${escapeHtml(route.vehicle_id)} charges at ${escapeHtml(charge.charger_id)} ${localTime(charge.arrive)}–` +
+        `${localTime(charge.depart)}: ${percent(charge.soc_before)} → ${percent(charge.soc_after)}`,
+        route.vehicle_id).addTo(planLayer);
     }
-  });
-  state.routes.forEach((route) => {
-    // A reload stands at the depot; a break where the van stands when it begins.
+    const depot = state.request && state.request.depot;
     for (const reload of route.reloads || []) {
       if (!depot) break;
-      const [x, y] = at(depot.lat, depot.lon);
-      map.appendChild(titled(svg("circle", {
-        cx: x, cy: y, r: 13, fill: "none", stroke: "#c46a00", "stroke-width": 2.5,
-        "data-testid": "reload-marker",
-      }), `${route.vehicle_id} reloads ${localTime(reload.arrive)}–${localTime(reload.depart)}`));
+      marker(depot.lat, depot.lon, icon("reload-icon", "↺", { "data-testid": "reload-marker" }),
+        `${escapeHtml(route.vehicle_id)} reloads ${localTime(reload.arrive)}–${localTime(reload.depart)}`,
+        route.vehicle_id).addTo(planLayer);
     }
     for (const pause of route.breaks || []) {
+      // A break where the van stands when it begins.
       const begins = Date.parse(pause.start);
       const before = route.legs.filter((leg) => Date.parse(leg.arrive) <= begins + 1000).pop();
       const place = state.places[before ? before.to_id : route.legs[0].from_id];
       if (!place) continue;
-      const [x, y] = at(place.lat, place.lon);
-      map.appendChild(titled(svg("rect", {
-        x: x + 7, y: y - 15, width: 9, height: 9, rx: 2, fill: "#7b61c4",
-        "data-testid": "break-marker",
-      }), `${route.vehicle_id} break (${pause.kind}) ${localTime(pause.start)}–${localTime(pause.end)}`));
+      marker(place.lat, place.lon, icon("break-icon", "☕", { "data-testid": "break-marker" }),
+        `${escapeHtml(route.vehicle_id)} break (${escapeHtml(pause.kind)}) ${localTime(pause.start)}–${localTime(pause.end)}`,
+        route.vehicle_id).addTo(planLayer);
     }
   });
+  const depot = state.request && state.request.depot;
+  if (depot) {
+    marker(depot.lat, depot.lon, icon("depot-icon", "", { "data-testid": "depot-marker" }),
+      `Depot ${escapeHtml(depot.id)}`).addTo(planLayer);
+  }
   for (const item of unassignedOf()) {
     const place = state.places[item.id];
     if (!place) continue;
-    const [x, y] = at(place.lat, place.lon);
-    map.appendChild(titled(svg("path", {
-      d: `M${x - 6},${y - 6} L${x + 6},${y + 6} M${x - 6},${y + 6} L${x + 6},${y - 6}`,
-      stroke: "#b3261e", "stroke-width": 3, "data-testid": "unassigned-marker",
-    }), `${item.id} not served: ${item.reason} — ${item.detail}`));
+    marker(place.lat, place.lon, icon("unassigned-icon", "✕", { "data-testid": "unassigned-marker" }),
+      `${escapeHtml(item.id)} not served: ${escapeHtml(item.reason)} — ${escapeHtml(item.detail)}`).addTo(planLayer);
   }
-  // The scale, at the map's middle latitude.
-  const middle = (y0 + y1) / 2;
-  const lat = (Math.atan(Math.sinh(Math.PI * (1 - 2 * middle))) * 180) / Math.PI;
-  const metresPerPixel = (40075016.686 * Math.cos((lat * Math.PI) / 180)) / scale;
-  const metres = niceLength(120 * metresPerPixel);
-  const pixels = metres / metresPerPixel;
-  const bar = svg("g", { "data-testid": "scale-bar" });
-  bar.appendChild(svg("rect", { x: 10, y: height - 30, width: pixels + 16, height: 22, fill: "#fff", "fill-opacity": 0.8 }));
-  bar.appendChild(svg("path", {
-    d: `M18,${height - 14} v4 h${pixels} v-4`, stroke: "#1d2733", "stroke-width": 2, fill: "none",
-  }));
-  bar.appendChild(svg("text", { x: 18, y: height - 18, "font-size": 11, fill: "#1d2733" },
-    metres >= 1000 ? `${metres / 1000} km` : `${metres} m`));
-  map.appendChild(bar);
-  const credit = [document.body.dataset.tileAttribution, state.answer && state.answer.attribution]
-    .filter(Boolean).join(" · ");
-  if (credit) {
-    map.appendChild(svg("text", {
-      x: width - 6, y: height - 6, "text-anchor": "end", "font-size": 10, fill: "#3b4855",
-    }, credit));
+  const credit = state.answer && state.answer.attribution;
+  if (map.planCredit) map.attributionControl.removeAttribution(map.planCredit);
+  map.planCredit = credit ? escapeHtml(credit) : null;
+  if (map.planCredit) map.attributionControl.addAttribution(map.planCredit);
+  map.legend.update();
+  const bounds = planLayer.getBounds();
+  if (bounds.isValid()) map.fitBounds(bounds, { padding: [30, 30], maxZoom: 16 });
+}
+
+function highlight(vehicleId) {
+  // One route's line, markers, legend entry and card together; the others fade.
+  for (const [id, line] of Object.entries(state.lines || {})) {
+    const on = vehicleId === null || id === vehicleId;
+    line.setStyle({ opacity: on ? 0.85 : 0.15, weight: vehicleId !== null && on ? 6 : 4 });
+    if (vehicleId !== null && on) line.bringToFront();
+  }
+  for (const node of document.querySelectorAll("[data-vehicle]")) {
+    node.classList.toggle("active", vehicleId !== null && node.dataset.vehicle === vehicleId);
+    node.classList.toggle("faded", vehicleId !== null && node.dataset.vehicle !== vehicleId &&
+      node.matches(".map-icon, .legend-route"));
   }
 }
 
-// ---------------------------------------------------------------- totals and routes
+// ---------------------------------------------------------------- totals and assumptions
+
+function facts(box, items) {
+  box.replaceChildren();
+  for (const [name, value, cls] of items) {
+    const span = el("span", cls ? { class: cls } : {});
+    span.append(`${name}: `, el("b", {}, value));
+    box.appendChild(span);
+  }
+}
+
+function gridKwh(route) {
+  // Pre-conditioning before departure, and each charge's draw on the way.
+  return route.totals.grid_kwh + (route.charges || []).reduce((n, c) => n + c.grid_kwh, 0);
+}
 
 function drawFleet() {
-  const card = $("fleet-card");
-  card.hidden = false;
-  const totals = $("fleet-totals");
-  totals.replaceChildren();
-  const served = state.routes.reduce((n, r) => n + r.stops.length, 0);
-  const distance = state.routes.reduce((n, r) => n + r.totals.distance_m, 0);
-  const energy = state.routes.reduce((n, r) => n + r.totals.energy_kwh.total, 0);
-  const grid = state.routes.reduce((n, r) => n + r.totals.grid_kwh, 0);
-  const items = [
-    ["Vans", String(state.routes.length)], ["Stops served", String(served)],
-    ["Not served", String(unassignedOf().length)], ["Distance", km(distance)],
-    ["Energy", kwh(energy)], ["From the grid", kwh(grid)],
-  ];
-  for (const [name, value] of items) {
-    const span = el("span");
-    span.append(`${name}: `, el("b", {}, value));
-    totals.appendChild(span);
-  }
+  $("fleet-card").hidden = false;
+  const sum = (f) => state.routes.reduce((n, r) => n + f(r), 0);
+  const breaks = state.routes.filter((r) => r.cold_chain && r.cold_chain.verdict === "breaks");
+  const chains = state.routes.filter((r) => r.cold_chain);
+  facts($("fleet-totals"), [
+    ["Vans", String(state.routes.length)], ["Stops served", String(sum((r) => r.stops.length))],
+    ["Not served", String(unassignedOf().length)], ["Distance", km(sum((r) => r.totals.distance_m))],
+    ["Energy", kwh(sum((r) => r.totals.energy_kwh.total))],
+    ["From the grid", kwh(sum(gridKwh))],
+    ...(chains.length ? [["Cold chain", breaks.length ? `breaks on ${breaks.length} of ${chains.length}` : "holds",
+      breaks.length ? "bad" : "ok"]] : []),
+  ]);
   const warnings = $("warnings");
   warnings.replaceChildren();
+  const all = [...((state.endpoint === "fleet-plans" && state.answer.warnings) || [])];
   for (const route of state.routes) {
-    for (const warning of route.warnings || []) {
-      warnings.appendChild(el("div", { class: "warning" }, `${route.vehicle_id}: ${warning}`));
-    }
+    for (const warning of route.warnings || []) all.push(`${route.vehicle_id}: ${warning}`);
   }
+  for (const warning of all) warnings.appendChild(el("div", { class: "warning", "data-testid": "warning" }, warning));
   const list = $("unassigned-list");
   list.replaceChildren();
   const left = unassignedOf();
@@ -597,15 +817,79 @@ function drawFleet() {
   }
 }
 
+function speedsAssumed() {
+  // The mean speed of the legs of each street type: what straight-line distances assumed.
+  const byType = {};
+  for (const route of state.routes) {
+    for (const leg of route.legs) {
+      const t = leg.street_type || "legs";
+      byType[t] = byType[t] || { m: 0, s: 0, n: 0 };
+      byType[t].m += leg.distance_m;
+      byType[t].s += leg.duration_s;
+      byType[t].n += 1;
+    }
+  }
+  return Object.entries(byType).map(([t, v]) =>
+    `${t} ${fixed((v.m / Math.max(v.s, 1)) * 3.6, 0)} km/h (${v.n} leg${v.n === 1 ? "" : "s"})`).join(", ");
+}
+
+const DISTANCE_SOURCES = {
+  osrm: "roads (the OSRM router)",
+  client: "the request's own distance and duration matrix",
+  estimate: "straight lines (great circle × a detour factor), not roads",
+};
+
+function describeVan(van) {
+  const v = van.vehicle || {};
+  const parts = [v.profile ? `profile ${v.profile}` : `preset ${v.preset || "paper-generic"}`];
+  if (van.battery && van.battery.usable_capacity_kwh) parts.push(`${van.battery.usable_capacity_kwh} kWh`);
+  if (van.payload_kg !== undefined) parts.push(`${van.payload_kg} kg payload`);
+  if (van.shift_start) parts.push(`shift ${van.shift_start}–${van.shift_end || ""}`);
+  if (van.start_time) parts.push(`leaves ${van.start_time}`);
+  return parts.join(", ");
+}
+
+function drawAssumptions() {
+  const answer = state.answer;
+  const request = state.request || {};
+  const list = $("assumptions");
+  list.replaceChildren();
+  const add = (term, text) => {
+    list.appendChild(el("dt", {}, term));
+    list.appendChild(el("dd", {}, text));
+  };
+  const first = state.routes[0] || {};
+  const weather = first.weather || answer.weather;
+  if (weather) {
+    add("Weather", `${weather.source}: ${fixed(weather.t_min_c, 1)} to ${fixed(weather.t_max_c, 1)} °C`);
+  }
+  const source = answer.distance_source || first.distance_source;
+  if (source) add("Distances", `${DISTANCE_SOURCES[source] || source}; speeds ${speedsAssumed()}`);
+  add("Day", `${request.date || ""}, times in ${answer.timezone || request.timezone || "local time"}`);
+  const vansAsked = Array.isArray(request.vehicles) ? request.vehicles : [request];
+  const counted = {};
+  for (const van of vansAsked) {
+    const text = describeVan(van);
+    counted[text] = (counted[text] || 0) + 1;
+  }
+  add("Vans", Object.entries(counted).map(([text, n]) => `${n} × ${text}`).join("; "));
+  const strategies = new Set(state.routes.map((r) => (r.refrigeration ? r.refrigeration.strategy : "thermostat")));
+  const product = (vansAsked[0] && vansAsked[0].cargo_box && vansAsked[0].cargo_box.product) || "none given";
+  add("Refrigeration", `${[...strategies].join(", ")}; product ${typeof product === "string" ? product : "a band of its own"}`);
+  $("assumptions-card").hidden = false;
+}
+
+// ---------------------------------------------------------------- routes
+
 function drawRoutes() {
   const box = $("routes");
-  box.replaceChildren();
   state.routes.forEach((route, r) => {
-    const colour = ROUTE_COLOURS[r % ROUTE_COLOURS.length];
     const card = el("div", { class: "card", "data-testid": "route", "data-vehicle": route.vehicle_id });
+    card.addEventListener("mouseenter", () => highlight(route.vehicle_id));
+    card.addEventListener("mouseleave", () => highlight(null));
     const title = el("h2");
     const swatch = el("span", { class: "swatch" });
-    swatch.style.background = colour;
+    swatch.style.background = colourOf(r);
     title.append(swatch, `${route.vehicle_id} · ${route.stops.length} stops`);
     const sheet = el("button", { type: "button", class: "secondary", "data-testid": "run-sheet" }, "Run sheet");
     sheet.addEventListener("click", () => printRunSheet(route));
@@ -613,133 +897,108 @@ function drawRoutes() {
     card.appendChild(title);
     const battery = route.battery;
     const totals = el("div", { class: "totals" });
-    const facts = [
+    const chain = route.cold_chain;
+    const unit = route.refrigeration;
+    facts(totals, [
       ["Distance", km(route.totals.distance_m)],
-      ["Time", `${(route.totals.duration_s / 3600).toFixed(1)} h`],
+      ["Time", `${fixed(route.totals.duration_s / 3600, 1)} h`],
       ["Energy", kwh(route.totals.energy_kwh.total)],
       ...CONSUMERS.map((c) => [c, kwh(route.totals.energy_kwh[c])]),
+      ["From the grid", kwh(gridKwh(route))],
       ["Lowest SoC", percent(battery.min_soc)],
       ["Charges", String((route.charges || []).length)],
       ["Reloads", String((route.reloads || []).length)],
       ["Breaks", String((route.breaks || []).length)],
-    ];
-    for (const [name, value] of facts) {
-      const span = el("span");
-      span.append(`${name}: `, el("b", {}, value));
-      totals.appendChild(span);
-    }
-    const verdict = el("span", { class: battery.feasible ? "ok" : "bad" },
-      battery.feasible ? "battery holds" : "battery runs short");
-    totals.appendChild(verdict);
+      ["Battery", battery.feasible ? "holds its reserve" : "runs short", battery.feasible ? "ok" : "bad"],
+      ...(unit ? [["Unit", `${unit.strategy}, ${kwh(unit.battery_kwh)} from the battery (thermostat ${kwh(unit.thermostat_battery_kwh)})`]] : []),
+      ...(chain ? [["Cold chain", chain.verdict === "holds"
+        ? `holds (goods ${celsius(chain.product_min_c)} … ${celsius(chain.product_max_c)})`
+        : `breaks at ${chain.first_break_stop || "the start"}: ${chain.reason}`, chain.verdict === "holds" ? "ok" : "bad"]] : []),
+    ]);
+    totals.lastChild.dataset.testid = chain ? "cold-chain" : "";
     card.appendChild(totals);
     const charts = el("div", { class: "charts" });
-    charts.append(socChart(route), energyChart(route), boxChart(route));
     card.appendChild(charts);
     card.appendChild(stopTable(route));
     box.appendChild(card);
+    for (const make of [socChart, energyChart, boxChart]) make(route, charts);
   });
 }
 
-// ---------------------------------------------------------------- charts
+// ---------------------------------------------------------------- charts (uPlot)
 
-function chartFrame(testid, title, route, yLow, yHigh, yLabel) {
-  const [t0, t1] = timeRange(route);
-  const width = 480;
-  const height = 190;
-  const margin = { left: 44, right: 10, top: 22, bottom: 24 };
-  const chart = svg("svg", { class: "chart", viewBox: `0 0 ${width} ${height}`, "data-testid": testid });
-  chart.appendChild(svg("text", { x: margin.left, y: 14, "font-size": 12, "font-weight": 600, fill: "#1d2733" }, title));
-  const x = (t) => margin.left + ((t - t0) / Math.max(t1 - t0, 1)) * (width - margin.left - margin.right);
-  const y = (v) => height - margin.bottom - ((v - yLow) / Math.max(yHigh - yLow, 1e-9)) * (height - margin.top - margin.bottom);
-  const axes = svg("g", { stroke: "#9aa6b2", "stroke-width": 1 });
-  axes.appendChild(svg("line", { x1: margin.left, y1: y(yLow), x2: width - margin.right, y2: y(yLow) }));
-  axes.appendChild(svg("line", { x1: margin.left, y1: y(yLow), x2: margin.left, y2: y(yHigh) }));
-  chart.appendChild(axes);
-  for (const v of [yLow, (yLow + yHigh) / 2, yHigh]) {
-    chart.appendChild(svg("text", { x: margin.left - 4, y: y(v) + 4, "text-anchor": "end", "font-size": 10, fill: "#4a5866" }, yLabel(v)));
-  }
-  // Ticks on whole hours of the round's local clock (its times carry their UTC offset).
-  const hour = 3600e3;
-  const local0 = clockHours(route.legs[0].depart);
-  const every = Math.max(1, Math.round((t1 - t0) / hour / 6));
-  for (let h = Math.ceil(local0); t0 + (h - local0) * hour <= t1; h += every) {
-    const t = t0 + (h - local0) * hour;
-    const label = `${String(((h % 24) + 24) % 24).padStart(2, "0")}:00`;
-    chart.appendChild(svg("text", { x: x(t), y: height - 8, "text-anchor": "middle", "font-size": 10, fill: "#4a5866" }, label));
-  }
-  return { chart, x, y };
+function spansOf(route) {
+  // What the van does when, as [kind, from, to] on the plan's local clock [s].
+  const out = [];
+  for (const c of route.charges || []) out.push(["charge", wallClock(c.arrive), wallClock(c.depart)]);
+  for (const b of route.breaks || []) out.push(["break", wallClock(b.start), wallClock(b.end)]);
+  for (const r of route.reloads || []) out.push(["reload", wallClock(r.arrive), wallClock(r.depart)]);
+  return out;
 }
 
-function clockHours(iso) {
-  // The local time of day of an ISO time with offset, in hours (06:30:00 is 6.5).
-  if (!iso) return 0;
-  return Number(iso.slice(11, 13)) + Number(iso.slice(14, 16)) / 60 + Number(iso.slice(17, 19)) / 3600;
+function doorSpans(route) {
+  // Each stop's door open from the start of its service for the planned door time.
+  return route.stops.map((s) => {
+    const open = Number((state.places[s.id] || {}).door_open_s || 0);
+    const from = wallClock(s.service_start || s.arrival);
+    return ["door", from, from + open];
+  }).filter(([, a, b]) => b > a);
 }
 
-function spans(route) {
-  const bands = [];
-  for (const c of route.charges || []) bands.push([c.arrive, c.depart, "#d9f2d9", `charge at ${c.charger_id}`]);
-  for (const b of route.breaks || []) bands.push([b.start, b.end, "#e6e0f5", `break (${b.kind})`]);
-  for (const r of route.reloads || []) bands.push([r.arrive, r.depart, "#fde9d0", "reload"]);
-  return bands;
+function spanPlugin(spans) {
+  // The shaded spans behind the lines.
+  return {
+    hooks: {
+      drawClear: [(u) => {
+        const { ctx } = u;
+        ctx.save();
+        for (const [kind, from, to] of spans) {
+          const x0 = u.valToPos(from, "x", true);
+          const x1 = u.valToPos(to, "x", true);
+          ctx.fillStyle = SPANS[kind][1];
+          ctx.fillRect(x0, u.bbox.top, Math.max(x1 - x0, 2), u.bbox.height);
+        }
+        ctx.restore();
+      }],
+    },
+  };
 }
 
-function drawBands(frame, route, top, bottom) {
-  for (const [start, end, colour, text] of spans(route)) {
-    const x0 = frame.x(Date.parse(start));
-    const x1 = frame.x(Date.parse(end));
-    frame.chart.insertBefore(titled(svg("rect", {
-      x: x0, y: top, width: Math.max(x1 - x0, 1.5), height: bottom - top, fill: colour,
-      "data-testid": "chart-band",
-    }), `${text} ${localTime(start)}–${localTime(end)}`), frame.chart.children[1]);
+function chart(route, holder, testid, title, data, series, spans, yLabel, yRange) {
+  const frame = el("figure", { class: "chart", "data-testid": testid, "data-vehicle": route.vehicle_id });
+  frame.appendChild(el("figcaption", {}, title));
+  holder.appendChild(frame);
+  const width = Math.max(frame.clientWidth - 14, 300);
+  const font = "13px system-ui, sans-serif";
+  // The plan's local clock, 24 h, read in UTC (see wallClock).
+  const clock = (u, splits) => splits.map((v) => new Date(v * 1000).toISOString().slice(11, 16));
+  const plot = new uPlot({
+    width, height: 260,
+    tzDate: (ts) => uPlot.tzDate(new Date(ts * 1e3), "Etc/UTC"),
+    cursor: { sync: { key: `route-${route.vehicle_id}` }, drag: { x: true, y: false } },
+    scales: { x: { time: true }, y: yRange ? { range: yRange } : {} },
+    axes: [
+      { font, stroke: "#1d2733", grid: { stroke: "#e3e8ee" }, values: clock, space: 60 },
+      { font, stroke: "#1d2733", label: yLabel, labelFont: font, size: 60, grid: { stroke: "#e3e8ee" } },
+    ],
+    series: [{ label: "time (local)", value: (u, v) => (v === null ? "" : new Date(v * 1000).toISOString().slice(11, 16)) }, ...series],
+    plugins: [spanPlugin(spans)],
+  }, data, frame);
+  const legend = el("p", { class: "span-legend" });
+  for (const kind of new Set(spans.map(([k]) => k))) {
+    const swatch = el("span", { class: "swatch" });
+    swatch.style.background = SPANS[kind][1];
+    legend.append(swatch, ` ${SPANS[kind][0]}  `);
   }
+  legend.append(el("span", { class: "hint" }, "Drag across a chart to zoom, double-click to zoom out."));
+  frame.appendChild(legend);
+  frame.plot = plot;
+  state.charts.push(plot);
+  return plot;
 }
 
-function timeRange(route) {
-  const start = Date.parse(route.legs[0].depart);
-  const end = Date.parse(route.legs[route.legs.length - 1].arrive);
-  return [start, Math.max(end, start + 60e3)];
-}
-
-function socPoints(route) {
-  const points = [];
-  for (const leg of route.legs) {
-    points.push([Date.parse(leg.depart), leg.soc_start, `leave ${leg.from_id}`]);
-    points.push([Date.parse(leg.arrive), leg.soc_end, `reach ${leg.to_id}`]);
-  }
-  for (const c of route.charges || []) {
-    points.push([Date.parse(c.arrive), c.soc_before, `plug in at ${c.charger_id}`]);
-    points.push([Date.parse(c.depart), c.soc_after, `unplug at ${c.charger_id}`]);
-  }
-  return points.sort((a, b) => a[0] - b[0]);
-}
-
-function socChart(route) {
-  const [t0, t1] = timeRange(route);
-  const frame = chartFrame("soc-chart", "State of charge", route, 0, 1, percent);
-  const profile = route.profile;
-  const points = socPoints(route);
-  const curve = profile && profile.soc
-    ? profile.time.map((t, k) => [Date.parse(t), profile.soc[k]])
-    : points.map(([t, s]) => [t, s]);
-  drawBands(frame, route, frame.y(1), frame.y(0));
-  const reserve = reserveOf(route);
-  if (reserve !== null) {
-    frame.chart.appendChild(titled(svg("line", {
-      x1: frame.x(t0), x2: frame.x(t1), y1: frame.y(reserve), y2: frame.y(reserve),
-      stroke: "#b3261e", "stroke-dasharray": "5 4", "stroke-width": 1.5, "data-testid": "reserve-line",
-    }), `reserve ${percent(reserve)}`));
-  }
-  frame.chart.appendChild(svg("polyline", {
-    points: curve.map(([t, s]) => `${frame.x(t).toFixed(1)},${frame.y(s).toFixed(1)}`).join(" "),
-    fill: "none", stroke: "#1d5c8a", "stroke-width": 2,
-  }));
-  for (const [t, s, what] of points) {
-    frame.chart.appendChild(titled(svg("circle", {
-      cx: frame.x(t), cy: frame.y(s), r: 2.5, fill: "#1d5c8a", "data-testid": "soc-point",
-    }), `${what}: ${percent(s)} at ${new Date(t).toISOString().slice(11, 16)} UTC`));
-  }
-  return frame.chart;
+function profileTimes(route) {
+  return route.profile.time.map(wallClock);
 }
 
 function reserveOf(route) {
@@ -749,117 +1008,129 @@ function reserveOf(route) {
   return null;
 }
 
-function cumulativeEnergy(route) {
-  if (route.profile && route.profile.energy_kwh) {
-    return route.profile.time.map((t, k) => [Date.parse(t),
-      Object.fromEntries(CONSUMERS.map((c) => [c, route.profile.energy_kwh[c][k]]))]);
-  }
-  // Without the day profile: the sums at each leg's and stop's end.
-  const sum = Object.fromEntries(CONSUMERS.map((c) => [c, 0]));
-  const points = [[Date.parse(route.legs[0].depart), { ...sum }]];
-  const stops = Object.fromEntries(route.stops.map((s) => [s.id, s]));
-  for (const leg of route.legs) {
-    for (const c of CONSUMERS) sum[c] += leg.energy_kwh[c];
-    points.push([Date.parse(leg.arrive), { ...sum }]);
-    const stop = stops[leg.to_id];
-    if (stop) {
-      for (const c of CONSUMERS) sum[c] += stop.energy_kwh[c];
-      points.push([Date.parse(stop.departure), { ...sum }]);
-    }
-  }
-  return points;
-}
-
-function energyChart(route) {
-  const points = cumulativeEnergy(route);
-  const top = Math.max(...points.map(([, e]) => CONSUMERS.reduce((n, c) => n + e[c], 0)), 0.1);
-  const frame = chartFrame("energy-chart", "Energy per consumer (cumulative, stacked)", route, 0, top, (v) => `${v.toFixed(0)} kWh`);
-  const below = points.map(() => 0);
-  for (const consumer of CONSUMERS) {
-    const above = points.map(([, e], k) => below[k] + e[consumer]);
-    const upper = points.map(([t], k) => `${frame.x(t).toFixed(1)},${frame.y(above[k]).toFixed(1)}`);
-    const lower = points.map(([t], k) => `${frame.x(t).toFixed(1)},${frame.y(below[k]).toFixed(1)}`).reverse();
-    frame.chart.appendChild(titled(svg("polygon", {
-      points: [...upper, ...lower].join(" "), fill: CONSUMER_COLOURS[consumer], "fill-opacity": 0.8,
-      "data-testid": "energy-area", "data-consumer": consumer,
-    }), `${consumer}: ${kwh(route.totals.energy_kwh[consumer])}`));
-    above.forEach((v, k) => { below[k] = v; });
-  }
-  CONSUMERS.forEach((consumer, k) => {
-    frame.chart.appendChild(svg("rect", { x: 60 + k * 100, y: 28, width: 9, height: 9, fill: CONSUMER_COLOURS[consumer] }));
-    frame.chart.appendChild(svg("text", { x: 72 + k * 100, y: 36, "font-size": 10, fill: "#1d2733" }, consumer));
-  });
-  return frame.chart;
-}
-
-function boxChart(route) {
-  const [t0, t1] = timeRange(route);
-  const series = route.profile && route.profile.box_temperature_c;
-  const limit = route.box && typeof route.box.product_limit_c === "number" ? route.box.product_limit_c : null;
-  const values = [...(series || []), ...(limit === null ? [] : [limit])];
-  const low = Math.floor(Math.min(...values, 0) - 1);
-  const high = Math.ceil(Math.max(...values, 8) + 1);
-  const frame = chartFrame("box-chart", "Cargo-box temperature", route, low, high, (v) => `${v.toFixed(0)} °C`);
-  drawBands(frame, route, frame.y(high), frame.y(low));
-  if (limit !== null) {
-    frame.chart.appendChild(titled(svg("line", {
-      x1: frame.x(t0), x2: frame.x(t1), y1: frame.y(limit), y2: frame.y(limit),
-      stroke: "#b3261e", "stroke-dasharray": "5 4", "stroke-width": 1.5, "data-testid": "product-limit",
-    }), `product limit ${limit} °C`));
-  }
-  if (series) {
-    frame.chart.appendChild(svg("polyline", {
-      points: route.profile.time.map((t, k) => `${frame.x(Date.parse(t)).toFixed(1)},${frame.y(series[k]).toFixed(1)}`).join(" "),
-      fill: "none", stroke: "#0b7a75", "stroke-width": 2, "data-testid": "box-line",
-    }));
+function socChart(route, holder) {
+  let times;
+  let soc;
+  if (route.profile) {
+    times = profileTimes(route);
+    soc = route.profile.soc.map((s) => 100 * s);
   } else {
-    frame.chart.appendChild(svg("text", { x: 52, y: frame.y(low) - 8, "font-size": 11, fill: "#4a5866" },
-      "Steady box: the unit holds the set-point (dynamic mode draws the temperature)."));
+    const points = [];
+    for (const leg of route.legs) points.push([leg.depart, leg.soc_start], [leg.arrive, leg.soc_end]);
+    for (const c of route.charges || []) points.push([c.arrive, c.soc_before], [c.depart, c.soc_after]);
+    points.sort((a, b) => Date.parse(a[0]) - Date.parse(b[0]));
+    times = points.map(([t]) => wallClock(t));
+    soc = points.map(([, s]) => 100 * s);
   }
-  return frame.chart;
+  const reserve = reserveOf(route);
+  const series = [{ label: "state of charge", stroke: "#1d5c8a", width: 2, value: (u, v) => (v === null ? "" : `${fixed(v, 1)} %`) }];
+  const data = [times, soc];
+  if (reserve !== null) {
+    series.push({ label: `reserve ${percent(reserve)}`, stroke: "#b3261e", dash: [6, 4], width: 1.5, points: { show: false } });
+    data.push(times.map(() => 100 * reserve));
+  }
+  chart(route, holder, "soc-chart", "State of charge [%]", data, series, spansOf(route), "%", [0, 100]);
 }
 
-// ---------------------------------------------------------------- tables, sheets, exports
-
-function timeline(route) {
-  // Stops, charges, reloads and breaks of a route in the order they happen.
-  const rows = route.stops.map((s, k) => ({ at: s.arrival, kind: "stop", n: k + 1, stop: s }));
-  for (const c of route.charges || []) rows.push({ at: c.arrive, kind: "charge", item: c });
-  for (const r of route.reloads || []) rows.push({ at: r.arrive, kind: "reload", item: r });
-  for (const b of route.breaks || []) rows.push({ at: b.start, kind: "break", item: b });
-  return rows.sort((a, b) => Date.parse(a.at) - Date.parse(b.at));
+function energyChart(route, holder) {
+  if (!route.profile) return;
+  const times = profileTimes(route);
+  const series = [...CONSUMERS, "total"].map((c) => ({
+    label: c, stroke: c === "total" ? "#1d2733" : CONSUMER_COLOURS[c], width: c === "total" ? 2.5 : 2,
+    value: (u, v) => (v === null ? "" : `${fixed(v, 2)} kWh`),
+  }));
+  const data = [times, ...[...CONSUMERS, "total"].map((c) => route.profile.energy_kwh[c])];
+  chart(route, holder, "energy-chart", "Energy per consumer since departure [kWh]", data, series, spansOf(route), "kWh");
 }
 
-function stopRow(row) {
-  const windows = (place) => ((place && place.time_windows) || []).map((w) => `${w.start}–${w.end}`).join(", ");
-  if (row.kind === "stop") {
-    const s = row.stop;
-    return [String(row.n), s.id, localTime(s.arrival), windows(state.places[s.id]), localTime(s.departure),
-      `${s.payload_after_kg.toFixed(0)} kg`, `${percent(s.soc_arrival)} → ${percent(s.soc_departure)}`,
-      `${s.door_heat_kwh.toFixed(2)} kWh door heat`];
+function boxChart(route, holder) {
+  const profile = route.profile;
+  const chain = route.cold_chain;
+  const air = profile && profile.box_temperature_c;
+  if (!profile || !air) {
+    const note = el("figure", { class: "chart", "data-testid": "box-chart", "data-vehicle": route.vehicle_id });
+    note.append(el("figcaption", {}, "Cargo box"), el("p", { class: "hint" },
+      "Steady box: the unit holds the set-point (the dynamic mode, or a product, draws the temperatures)."));
+    holder.appendChild(note);
+    return;
   }
-  const item = row.item;
-  if (row.kind === "charge") {
-    return ["⚡", item.charger_id, localTime(item.arrive), "", localTime(item.depart), "",
-      `${percent(item.soc_before)} → ${percent(item.soc_after)}`,
-      `charge ${item.battery_kwh.toFixed(1)} kWh, ${item.minutes.toFixed(0)} min`];
+  const times = profileTimes(route);
+  const value = (u, v) => (v === null || v === undefined ? "" : `${fixed(v, 1)} °C`);
+  const series = [{ label: "air", stroke: "#0b7a75", width: 2, value }];
+  const data = [times, air];
+  if (profile.product_temperature_c) {
+    series.push({ label: "goods", stroke: "#7a3b0b", width: 2.5, value });
+    data.push(profile.product_temperature_c);
   }
-  if (row.kind === "reload") {
-    return ["↺", "depot", localTime(item.arrive), "", localTime(item.depart), `${item.payload_kg.toFixed(0)} kg`, "", "reload"];
+  if (profile.air_setpoint_c) {
+    series.push({ label: "air set-point (schedule)", stroke: "#5b6b7a", dash: [3, 3], width: 1.5, value, points: { show: false } });
+    data.push(profile.air_setpoint_c);
   }
-  return ["☕", "", localTime(item.start), "", localTime(item.end), "", "", `break (${item.kind})`];
+  const limits = [];
+  if (chain) {
+    limits.push([`band floor ${celsius(chain.min_c)}`, chain.min_c], [`band ceiling ${celsius(chain.max_c)}`, chain.max_c]);
+    if (chain.excursion_c > 0) limits.push([`brief rises to ${celsius(chain.max_c + chain.excursion_c)}`, chain.max_c + chain.excursion_c]);
+  } else if (route.box && typeof route.box.product_limit_c === "number") {
+    limits.push([`product limit ${celsius(route.box.product_limit_c)}`, route.box.product_limit_c]);
+  }
+  for (const [label, level] of limits) {
+    series.push({ label, stroke: "#b3261e", dash: [6, 4], width: 1.2, value, points: { show: false } });
+    data.push(times.map(() => level));
+  }
+  const title = chain ? `Air and goods [°C] — cold chain ${chain.verdict}` : "Cargo-box air [°C]";
+  chart(route, holder, "box-chart", title, data, series, [...spansOf(route), ...doorSpans(route)], "°C");
 }
 
-const SHEET_HEAD = ["#", "Stop", "Arrive", "Window", "Leave", "Payload after", "SoC", "Note"];
+// ---------------------------------------------------------------- run sheet, exports
+
+function visitsOf(route) {
+  // The day in time order (the service's visits: stops, charges, reloads, breaks in place).
+  if (route.visits && route.visits.length) return route.visits;
+  const rows = route.stops.map((s) => ({ kind: "stop", id: s.id, arrive: s.arrival, start: s.service_start || s.arrival, depart: s.departure, soc_arrival: s.soc_arrival, soc_departure: s.soc_departure, payload_after_kg: s.payload_after_kg }));
+  return rows;
+}
+
+const SHEET_HEAD = ["#", "Stop", "Address / notes", "Arrive", "Wait", "Service", "Leave", "Unload",
+  "Payload after", "SoC", "Door", "Goods at delivery"];
+
+function sheetRows(route) {
+  const stops = Object.fromEntries(route.stops.map((s) => [s.id, s]));
+  let n = 0;
+  let payload = null;
+  const rows = [];
+  for (const visit of visitsOf(route)) {
+    const wait = (Date.parse(visit.start) - Date.parse(visit.arrive)) / 1000;
+    const soc = `${percent(visit.soc_arrival)} → ${percent(visit.soc_departure)}`;
+    if (visit.kind === "stop") {
+      n += 1;
+      const stop = stops[visit.id] || {};
+      const place = state.places[visit.id] || {};
+      const before = payload === null ? visit.payload_after_kg + (place.delivery_kg || 0) : payload;
+      const notes = Object.entries(state.extras[visit.id] || {}).filter(([, v]) => v).map(([, v]) => v).join(" · ");
+      const windows = (place.time_windows || []).map((w) => `${w.start}–${w.end}`).join(", ");
+      const goods = stop.product_temperature_c ? celsius(stop.product_temperature_c.arrival) : "";
+      rows.push([String(n), visit.id + (windows ? ` (${windows})` : ""), notes, localTime(visit.arrive),
+        wait > 30 ? minutes(wait) : "", localTime(visit.start), localTime(visit.depart),
+        `${fixed(Math.max(before - visit.payload_after_kg, 0), 0)} kg`, `${fixed(visit.payload_after_kg, 0)} kg`, soc,
+        place.door_open_s ? minutes(place.door_open_s) : "", goods]);
+    } else {
+      const what = { charge: `⚡ charge at ${visit.id}`, reload: "↺ reload at the depot", break: "☕ break" }[visit.kind] || visit.kind;
+      rows.push(["", what, "", localTime(visit.arrive), wait > 30 ? minutes(wait) : "", localTime(visit.start),
+        localTime(visit.depart), "", `${fixed(visit.payload_after_kg, 0)} kg`, soc, "", ""]);
+    }
+    payload = visit.payload_after_kg;
+  }
+  return rows;
+}
 
 function table(route) {
   const t = el("table");
   const head = el("tr");
-  for (const name of SHEET_HEAD) head.appendChild(el("th", {}, name));
+  for (const name of SHEET_HEAD) head.appendChild(el("th", { scope: "col" }, name));
   t.appendChild(head);
-  for (const row of timeline(route)) {
+  for (const row of sheetRows(route)) {
     const tr = el("tr");
-    for (const cell of stopRow(row)) tr.appendChild(el("td", {}, cell));
+    for (const cell of row) tr.appendChild(el("td", {}, cell));
     t.appendChild(tr);
   }
   return t;
@@ -875,10 +1146,11 @@ function stopTable(route) {
 function printRunSheet(route) {
   const area = $("print-area");
   area.replaceChildren();
-  const van = route.vehicle_id;
-  area.appendChild(el("h1", {}, `Run sheet — ${van} — ${state.request ? state.request.date : ""}`));
+  area.appendChild(el("h1", {}, `Run sheet — ${route.vehicle_id} — ${state.request ? state.request.date : ""}`));
+  const chain = route.cold_chain;
   area.appendChild(el("p", {}, `Leave ${localTime(route.legs[0].depart)}, back ${localTime(route.legs[route.legs.length - 1].arrive)}; ` +
-    `${km(route.totals.distance_m)}, ${route.stops.length} stops, lowest state of charge ${percent(route.battery.min_soc)}.`));
+    `${km(route.totals.distance_m)}, ${route.stops.length} stops, lowest state of charge ${percent(route.battery.min_soc)}` +
+    (chain ? `; cold chain ${chain.verdict}.` : ".")));
   area.appendChild(table(route));
   window.print();
 }
@@ -899,14 +1171,18 @@ function csvCell(value) {
 }
 
 function exportCsv() {
-  const rows = [["vehicle_id", "sequence", "stop_id", "arrival", "departure", "soc_arrival",
-    "soc_departure", "leg_energy_kwh", "stop_energy_kwh", "door_heat_kwh", "payload_after_kg"]];
+  const rows = [["vehicle_id", "sequence", "stop_id", "arrival", "service_start", "departure",
+    "soc_arrival", "soc_departure", "leg_energy_kwh", "stop_energy_kwh", "door_heat_kwh",
+    "payload_after_kg", "product_temperature_c", ...state.columns]];
   for (const route of state.routes) {
     const into = Object.fromEntries(route.legs.map((l) => [l.to_id, l]));
     route.stops.forEach((s, k) => {
-      rows.push([route.vehicle_id, k + 1, s.id, s.arrival, s.departure, s.soc_arrival.toFixed(4),
-        s.soc_departure.toFixed(4), into[s.id] ? into[s.id].energy_kwh.total.toFixed(4) : "",
-        s.energy_kwh.total.toFixed(4), s.door_heat_kwh.toFixed(4), s.payload_after_kg]);
+      const extra = state.extras[s.id] || {};
+      rows.push([route.vehicle_id, k + 1, s.id, s.arrival, s.service_start || "", s.departure,
+        fixed(s.soc_arrival, 4), fixed(s.soc_departure, 4), into[s.id] ? fixed(into[s.id].energy_kwh.total, 4) : "",
+        fixed(s.energy_kwh.total, 4), fixed(s.door_heat_kwh, 4), fixed(s.payload_after_kg, 1),
+        s.product_temperature_c ? fixed(s.product_temperature_c.arrival, 2) : "",
+        ...state.columns.map((c) => extra[c] || "")]);
     });
   }
   download("plan.csv", "text/csv", `${rows.map((r) => r.map(csvCell).join(",")).join("\r\n")}\r\n`);
@@ -927,7 +1203,7 @@ function exportGeojson() {
       features.push({ type: "Feature", geometry: { type: "Point", coordinates: [place.lon, place.lat] },
         properties: { kind: "stop", id: s.id, vehicle_id: route.vehicle_id, sequence: k + 1,
           arrival: s.arrival, departure: s.departure, door_heat_kwh: s.door_heat_kwh,
-          soc_arrival: s.soc_arrival, soc_departure: s.soc_departure } });
+          soc_arrival: s.soc_arrival, soc_departure: s.soc_departure, ...(state.extras[s.id] || {}) } });
     });
     for (const c of route.charges || []) {
       features.push({ type: "Feature", geometry: { type: "Point", coordinates: [c.lon, c.lat] },
@@ -952,6 +1228,9 @@ function exportGeojson() {
 async function start() {
   const tomorrow = new Date(Date.now() + 86400e3);
   $("date").value = tomorrow.toISOString().slice(0, 10);
+  addVanRow(true);
+  $("add-vans").addEventListener("click", () => addVanRow(false));
+  createMap();
   $("plan-form").addEventListener("submit", (event) => {
     plan(event).catch((error) => { $("plan").disabled = false; showError(`Unexpected: ${error.message}`); });
   });
@@ -962,13 +1241,29 @@ async function start() {
   });
   $("export-csv").addEventListener("click", exportCsv);
   $("export-geojson").addEventListener("click", exportGeojson);
-  window.addEventListener("resize", () => { if (state.answer) drawMap(); });
   await loadVans();
   if (job) follow(job, null, null);
 }
 
-// For scripts of dispatch teams (and the tests): the answer shown, as the service sent it.
-window.coldroute = { answer: () => state.answer, request: () => state.request };
+// For scripts of dispatch teams (and the tests): the answer shown, as the service sent it,
+// and what each chart draws.
+window.coldroute = {
+  answer: () => state.answer,
+  request: () => state.request,
+  markers: () => {
+    const numbers = {};
+    for (const m of state.stopsLayer ? state.stopsLayer.getLayers() : []) {
+      const node = m.options.icon.options.html;
+      (numbers[node.dataset.vehicle] = numbers[node.dataset.vehicle] || []).push(Number(node.textContent));
+    }
+    for (const list of Object.values(numbers)) list.sort((a, b) => a - b);
+    return numbers;
+  },
+  charts: () => [...document.querySelectorAll("figure.chart")].filter((f) => f.plot).map((f) => ({
+    testid: f.dataset.testid, vehicle: f.dataset.vehicle,
+    series: f.plot.series.slice(1).map((s) => s.label), points: f.plot.data[0].length,
+  })),
+};
 
 document.addEventListener("DOMContentLoaded", () => {
   start().catch((error) => showError(`Unexpected: ${error.message}`));

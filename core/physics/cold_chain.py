@@ -47,6 +47,9 @@ from core.physics.strategy import GRID_S, GRID_WEIGHT, BoxDay, optimal_schedule
 
 #: Step of the two-node integration [s].
 BOX_STEP_S = 10.0
+#: Most steps of the strategy's programme: a day of minutes; a longer trace (days on the
+#: road) is planned on a coarser grid, so its solve stays within a second or so.
+MAX_GRID_STEPS = 1440
 
 
 @dataclass(frozen=True)
@@ -324,6 +327,14 @@ def _result(
     )
 
 
+def grid_step_s(span_s: float) -> float:
+    """The programme's step for a trace of ``span_s`` [s]: a minute
+    (:data:`core.physics.strategy.GRID_S`), coarser beyond a day — at most
+    :data:`MAX_GRID_STEPS` steps, so a trace of days on the road is planned in about the
+    time of one day."""
+    return max(GRID_S, span_s / MAX_GRID_STEPS)
+
+
 def plan_setpoints(
     box: CargoBoxParams,
     outside: Outside,
@@ -331,18 +342,20 @@ def plan_setpoints(
     dt_s: float,
     start_c: tuple[float, float],
     run: Run,
-    grid_s: float = GRID_S,
+    grid_s: float | None = None,
 ) -> Setpoints:
     """The optimal strategy's set-points for the day ahead (the arguments as
     :func:`box_with_goods`'): the day on the programme's grid of ``grid_s`` [s] (its steps'
-    means), after the minutes at the depot it may pre-cool in. From a start under way
-    (``run.from_depot`` false) it is the receding horizon's re-plan: the rest of the day from
-    the box's state."""
+    means; by default :func:`grid_step_s`), after the minutes at the depot it may pre-cool
+    in. From a start under way (``run.from_depot`` false) it is the receding horizon's
+    re-plan: the rest of the day from the box's state."""
     ambient = outside[0]
     _, conductance, equilibrium = _flows(box, outside)
     weights, at_depot = run.weights()
     n = ambient.size
-    blocks = Blocks(n, max(round(grid_s / dt_s), 1))
+    per_block = max(round((grid_s or grid_step_s(n * dt_s)) / dt_s), 1)
+    step_s = per_block * dt_s
+    blocks = Blocks(n, per_block)
     counts, mean = blocks.counts, blocks.mean
     grid_outside = mean(ambient)
     days = [
@@ -357,13 +370,13 @@ def plan_setpoints(
             weight=mean(weights),
         )
     ]
-    m = math.ceil(run.strategy.precool_minutes * 60.0 / grid_s) if run.from_depot and n else 0
+    m = math.ceil(run.strategy.precool_minutes * 60.0 / step_s) if run.from_depot and n else 0
     if m:  # at the depot, door shut, out of the sun, on the grid
         wall = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
         days.insert(
             0,
             _constant_day(
-                m, (grid_s, at_depot), wall, (float(ambient[0]), float(payload_kg[0])), box
+                m, (step_s, at_depot), wall, (float(ambient[0]), float(payload_kg[0])), box
             ),
         )
     day = BoxDay(

@@ -685,6 +685,16 @@ class DayProfile(Result):
         description="Cargo-air temperature at each moment [°C] (dynamic box; null in steady "
         "mode, where the unit holds the set-point).",
     )
+    product_temperature_c: list[float | None] | None = Field(
+        None,
+        description="The goods' temperature at each moment [°C] (cargo_box.product; null "
+        "while none are aboard, and without a product).",
+    )
+    air_setpoint_c: list[float] | None = Field(
+        None,
+        description="The air set-point the unit follows at each moment [°C] (the optimal "
+        "strategy's schedule; null with the thermostat, which holds setpoint_c).",
+    )
 
 
 #: The parts of a plan a proof may cover: the order of its stops.

@@ -180,3 +180,27 @@ def test_the_day_profile_is_the_simulation_minute_by_minute(client):
     assert answer["battery"]["reserve_soc"] == 0.12
     assert answer["box"]["product_limit_c"] == 7.0
     assert client.post("/v1/plans", json=PLAN_EXAMPLE).json()["profile"] is None
+
+
+def test_a_stop_far_from_the_depot_is_planned_with_a_warning_naming_it(client):
+    from app.examples import FLEET_PLAN_EXAMPLE
+    from tests.app.apps import app_client
+
+    # Vienna's lat and lon swapped put a shop at 16.4 °N, 48.2 °E: about 4,100 km away (great
+    # circle from the depot at 48.17 °N, 16.42 °E, by the haversine)
+    stops = copy.deepcopy(PLAN_EXAMPLE["stops"])
+    stops[3] |= {"lat": stops[3]["lon"], "lon": stops[3]["lat"]}
+    answer = client.post("/v1/plans", json=PLAN_EXAMPLE | {"stops": stops}).json()
+    far = [w for w in answer["warnings"] if "from the depot" in w]
+    assert len(far) == 1 and far[0].startswith(f"stops[3] ('{stops[3]['id']}') is 4,")
+    assert "more than 300 km" in far[0]
+    fleet = copy.deepcopy(FLEET_PLAN_EXAMPLE)
+    fleet["stops"][0] |= {"lat": 16.4, "lon": 48.2}
+    warned = client.post("/v1/fleet-plans", json=fleet).json()["warnings"]
+    assert [w[:9] for w in warned if "from the depot" in w] == ["stops[0] "]
+    # the day as it is, nothing to warn of; a server that expects stops within 2 km warns
+    # of each farther one
+    plain = client.post("/v1/plans", json=PLAN_EXAMPLE).json()["warnings"]
+    assert not any("from the depot" in w for w in plain)
+    near = app_client(far_stop_km=2.0).post("/v1/plans", json=PLAN_EXAMPLE).json()["warnings"]
+    assert 0 < sum("from the depot" in w for w in near) <= len(PLAN_EXAMPLE["stops"])

@@ -109,6 +109,24 @@ def fill_day(tab: Page, csv_text: str, vans: int, tmp_path: Path, name: str = "s
     tab.fill("#time-limit", "2")
 
 
+def overlapping(markers) -> list[tuple[int, int]]:
+    """The pairs of ``markers`` whose boxes on screen overlap by more than a pixel."""
+    boxes = [markers.nth(k).bounding_box() for k in range(markers.count())]
+    return [
+        (i, j)
+        for i, a in enumerate(boxes)
+        for j, b in enumerate(boxes[:i])
+        if min(a["x"] + a["width"], b["x"] + b["width"]) - max(a["x"], b["x"]) > 1
+        and min(a["y"] + a["height"], b["y"] + b["height"]) - max(a["y"], b["y"]) > 1
+    ]
+
+
+def shown_stops(tab: Page) -> int:
+    """The stops on the map: each marker drawn alone, and each cluster's count."""
+    clustered = tab.locator(".marker-cluster span").all_text_contents()
+    return tab.get_by_test_id("stop-marker").count() + sum(int(n) for n in clustered)
+
+
 def test_a_csv_day_for_three_vans_on_the_map_and_in_the_charts(server, page, tmp_path):
     tab, outside = page
     tab.goto(f"{server.url}/viewer")
@@ -123,20 +141,26 @@ def test_a_csv_day_for_three_vans_on_the_map_and_in_the_charts(server, page, tmp
     routes = json.loads(answer)["routes"]
     assert tab.get_by_test_id("route-line").count() == len(routes) >= 2
     served = sum(len(r["stops"]) for r in routes)
-    assert tab.get_by_test_id("stop-marker").count() == served == len(stops) - 1
-    numbers = sorted(
-        int(n) for n in tab.locator("[data-testid=stop-marker] text").all_text_contents()
-    )
-    assert numbers == sorted(k + 1 for r in routes for k in range(len(r["stops"])))
-    # One SoC chart per route, a point at each leg's ends and each charge's ends.
-    assert tab.get_by_test_id("soc-chart").count() == len(routes)
-    for k, route in enumerate(routes):
-        chart = tab.get_by_test_id("soc-chart").nth(k)
-        expected = 2 * len(route["legs"]) + 2 * len(route["charges"])
-        assert chart.get_by_test_id("soc-point").count() == expected
-        assert chart.get_by_test_id("reserve-line").count() == 1
-    assert tab.get_by_test_id("energy-chart").count() == len(routes)
-    assert tab.get_by_test_id("box-chart").count() == len(routes)
+    assert shown_stops(tab) == served == len(stops) - 1
+    # each route's stops numbered in its order, clustered or not
+    numbers = tab.evaluate("window.coldroute.markers()")
+    assert numbers == {r["vehicle_id"]: list(range(1, len(r["stops"]) + 1)) for r in routes}
+    # Three charts per route, each drawing the route's day minute by minute: the state of
+    # charge with the reserve, each consumer's energy and the total, the box's air
+    charts = tab.evaluate("window.coldroute.charts()")
+    for route in routes:
+        drawn = {c["testid"]: c for c in charts if c["vehicle"] == route["vehicle_id"]}
+        minutes = len(route["profile"]["time"])
+        assert {c["points"] for c in drawn.values()} == {minutes}
+        assert drawn["soc-chart"]["series"] == ["state of charge", "reserve 10 %"]
+        assert drawn["energy-chart"]["series"] == [
+            "traction", "auxiliaries", "cabin", "refrigeration", "total"
+        ]  # fmt: skip
+        assert drawn["box-chart"]["series"][0] == "air"
+    for name in ("soc-chart", "energy-chart", "box-chart"):
+        assert tab.get_by_test_id(name).count() == len(routes)
+    legend = tab.get_by_test_id("map-legend").inner_text()
+    assert all(r["vehicle_id"] in legend for r in routes) and "not served" in legend
     unassigned = tab.get_by_test_id("unassigned")
     assert unassigned.count() == 1
     assert TOO_HEAVY in unassigned.inner_text() and "capacity" in unassigned.inner_text()
@@ -149,7 +173,7 @@ def test_a_csv_day_for_three_vans_on_the_map_and_in_the_charts(server, page, tmp
         r["vehicle_id"] for r in routes
     }
     assert [r["stop_id"] for r in rows if FORMULA in r["stop_id"]] == [f"'{FORMULA}"]
-    assert not any(cell[:1] in "=+@" for r in rows for cell in r.values())
+    assert not any(cell.startswith(("=", "+", "@")) for r in rows for cell in r.values())
     with tab.expect_download() as download:
         tab.get_by_test_id("export-geojson").click()
     features = json.loads(Path(download.value.path()).read_text())["features"]
@@ -170,9 +194,12 @@ def test_a_large_day_runs_as_a_job_and_reopens_by_its_url(server, page, tmp_path
     assert "?job=" in tab.url
     answer = json.loads(tab.evaluate("JSON.stringify(window.coldroute.answer())"))
     lines = tab.get_by_test_id("route-line").count()
-    markers = tab.get_by_test_id("stop-marker").count()
+    markers = shown_stops(tab)
     assert lines == len(answer["routes"]) >= 2
     assert markers == sum(len(r["stops"]) for r in answer["routes"])
+    # 70 stops: no two numbers on the map overlap (stops close together are clustered, each
+    # cluster saying how many it holds)
+    assert not overlapping(tab.locator("[data-testid=stop-marker], .marker-cluster"))
     assert tab.get_by_test_id("unassigned").count() == len(answer["unassigned"])
     shot(tab, "3-job")
 
@@ -183,7 +210,7 @@ def test_a_large_day_runs_as_a_job_and_reopens_by_its_url(server, page, tmp_path
     expect(tab.get_by_test_id("route-line").first).to_be_visible(timeout=30_000)
     assert tab.get_by_test_id("error").count() == 0
     assert tab.get_by_test_id("route-line").count() == lines
-    assert tab.get_by_test_id("stop-marker").count() == markers
+    assert shown_stops(tab) == markers
     assert tab.get_by_test_id("unassigned").count() == len(answer["unassigned"])
     shot(tab, "4-reopened")
     assert outside == []
@@ -240,7 +267,20 @@ def test_the_page_allows_only_its_own_host_and_the_tiles():
     assert f'data-tile-url="{tiles}"' in page.text
     script = client.get("/viewer/static/viewer.js")
     assert script.status_code == 200 and "text/javascript" in script.headers["content-type"]
-    assert client.get("/viewer/static/secrets.py").status_code == 404
+    # the libraries vendored with their licences; the page loads each from this host
+    for library, licence in [
+        ("vendor/leaflet/leaflet.js", "BSD 2-Clause"),
+        ("vendor/leaflet.markercluster/leaflet.markercluster.js", "MIT"),
+        ("vendor/uplot/uPlot.iife.min.js", "MIT"),
+    ]:
+        assert f'src="/viewer/static/{library}"' in page.text
+        assert client.get(f"/viewer/static/{library}").status_code == 200
+        folder = library.rsplit("/", 1)[0]
+        assert licence in client.get(f"/viewer/static/{folder}/LICENSE").text
+    icon = client.get("/viewer/static/vendor/leaflet/images/layers.png")
+    assert icon.headers["content-type"] == "image/png" and icon.content[:4] == b"\x89PNG"
+    for name in ("secrets.py", "../routers/viewer.py", "vendor/../../settings.py", "__init__.py"):
+        assert client.get(f"/viewer/static/{name}").status_code == 404
     # the audit: a 10 kB name echoed whole, and answers a browser might sniff
     missing = client.get("/viewer/static/" + "a" * 10_000 + ".js")
     assert missing.status_code == 404 and len(missing.content) < 1_000
@@ -266,9 +306,10 @@ def test_a_pasted_plan_on_real_roads_draws_the_roads_and_a_run_sheet(osrm_url, t
             tab.get_by_test_id("plan").click()
             line = tab.get_by_test_id("route-line")
             expect(line).to_have_count(1, timeout=60_000)
-            points = line.get_attribute("points").split()
-            assert len(points) > 5 * (len(body["stops"]) + 2)  # the roads, not straight legs
-            assert tab.get_by_test_id("stop-marker").count() == len(body["stops"])
+            points = int(line.get_attribute("data-points"))
+            assert points > 5 * (len(body["stops"]) + 2)  # the roads, not straight legs
+            assert "straight line" not in tab.get_by_test_id("map-legend").inner_text()
+            assert shown_stops(tab) == len(body["stops"])
             assert "OpenStreetMap" in tab.get_by_test_id("map").text_content()  # OSRM's credit
             shot(tab, "7-roads")
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -323,15 +324,23 @@ class _Split:
         picks = np.unique(np.append(np.arange(0, size, every), size - 1))
         kwh = {name: (c[picks] / JOULES_PER_KWH).tolist() for name, c in self.cumulative_j.items()}
         kwh["total"] = np.sum([kwh[name] for name in CONSUMERS], axis=0).tolist()
+        simulated_box = self.simulated.box
+        # the box's temperatures are at the end of each step: sample i ends step i - 1
+        steps = np.maximum(picks - 1, 0)
         box: list[float] | None = None
         if self.problem.van.cargo_box.mode == "dynamic":
-            # the box's temperature is at the end of each step: sample i ends step i - 1
-            box = self.simulated.box.temperature_c[np.maximum(picks - 1, 0)].tolist()
+            box = simulated_box.temperature_c[steps].tolist()
+        goods = simulated_box.product_c
+        setpoint = simulated_box.setpoint_c
         return DayProfile(
             time=[self.moment(int(i)) for i in picks],
             energy_kwh=kwh,
             soc=self.simulated.soc[picks].tolist(),
             box_temperature_c=box,
+            product_temperature_c=None
+            if goods is None
+            else [None if math.isnan(v) else v for v in goods[steps].tolist()],
+            air_setpoint_c=None if setpoint is None else setpoint[steps].tolist(),
         )
 
     def result(self, solved: Solved, warnings: list[str]) -> PlanResult:

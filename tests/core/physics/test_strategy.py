@@ -21,6 +21,7 @@ from core.physics.cold_chain import (
     box_with_goods,
     check_cold_chain,
     follow,
+    grid_step_s,
     plan_setpoints,
     two_nodes,
 )
@@ -193,3 +194,20 @@ def test_a_re_plan_from_a_warm_box_under_way_brings_the_air_back_and_keeps_the_g
     assert check.holds and check.product_max_c <= 6.0
     kept = box_with_goods(box, outside, payload, 1.0, start, Run(THERMOSTAT, np.zeros(n)))
     assert followed.power_w.sum() < kept.power_w.sum()
+
+
+def test_days_on_the_road_are_planned_on_a_coarser_grid_and_still_hold():
+    # a minute up to a day of 1,440 minutes; three days: 3 minutes, 1,440 steps again
+    assert grid_step_s(8 * HOUR) == 60.0 and grid_step_s(24 * HOUR) == 60.0
+    assert grid_step_s(72 * HOUR) == pytest.approx(180.0)
+    # three days at 30 °C with the goods aboard, on a one-minute trace: the coarse programme
+    # keeps them inside dairy's band and spares the battery against the thermostat
+    box = reference_box()
+    n = 72 * 60
+    outside = (np.full(n, 30.0), np.full(n, 250.0), np.zeros(n))
+    payload = np.full(n, 400.0)
+    start = (box.setpoint_c, box.load_c)
+    optimal = box_with_goods(box, outside, payload, 60.0, start, Run(OPTIMAL, np.zeros(n)))
+    check = check_cold_chain(PRODUCT_CLASSES["chilled-dairy"], optimal.product_c, 60.0)
+    assert check.holds
+    assert optimal.power_w.sum() < optimal.thermostat_power_w.sum()
