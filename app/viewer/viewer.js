@@ -30,7 +30,9 @@ const SPANS = {
 
 const state = {
   request: null, endpoint: null, answer: null, routes: [], places: {}, extras: {},
-  columns: [], charts: [],
+  columns: [], charts: [], jobId: null,
+  // The plans shown in this page, to compare; and the stops' order per van as edited.
+  history: [], order: {}, changed: new Set(),
 };
 let polling = null;
 let map = null;
@@ -473,7 +475,7 @@ function follow(jobId, request, endpoint) {
         job.status === "queued" ? ` (${Math.round((Date.now() - began) / 1000)} s waiting)` : "");
     if (job.status === "succeeded") {
       stopPolling();
-      show(asked, job.type === "plan" ? "plans" : "fleet-plans", job.result);
+      show(asked, job.type === "plan" ? "plans" : "fleet-plans", job.result, job.id);
     } else if (job.status === "failed") {
       stopPolling();
       showProblem(job.error, job.error && job.error.status);
@@ -512,17 +514,22 @@ function clearPlan() {
   $("routes").replaceChildren();
   $("fleet-card").hidden = true;
   $("assumptions-card").hidden = true;
+  $("work-card").hidden = true;
+  state.changed.clear();
   $("export-csv").disabled = true;
   $("export-geojson").disabled = true;
   if (map) map.legend.update();
 }
 
-function show(request, endpoint, answer) {
+function show(request, endpoint, answer, jobId = null, label = null) {
   clearPlan();
   state.request = request;
   state.endpoint = endpoint;
   state.answer = answer;
+  state.jobId = jobId;
   state.routes = routesOf(endpoint, answer);
+  state.order = Object.fromEntries(state.routes.map((r) => [r.vehicle_id, r.stops.map((x) => x.id)]));
+  remember(request, endpoint, answer, jobId, label);
   state.places = {};
   if (request) {
     if (request.depot) state.places[request.depot.id] = request.depot;
@@ -543,6 +550,7 @@ function show(request, endpoint, answer) {
   drawFleet();
   drawAssumptions();
   drawRoutes();
+  drawWork();
   $("export-csv").disabled = false;
   $("export-geojson").disabled = false;
 }
@@ -682,6 +690,10 @@ function drawMap() {
   // a click zooms in): numbers never overlap, at 7 stops or 700.
   const stopsLayer = L.markerClusterGroup({
     maxClusterRadius: CLUSTER_RADIUS_PX, disableClusteringAtZoom: 18, showCoverageOnHover: false,
+    iconCreateFunction: (cluster) => L.divIcon({
+      html: el("span", { "aria-label": `${cluster.getChildCount()} stops here: zoom in` }, String(cluster.getChildCount())),
+      className: "marker-cluster stop-cluster", iconSize: L.point(24, 24),
+    }),
   });
   stopsLayer.addTo(planLayer);
   state.stopsLayer = stopsLayer;
@@ -1123,24 +1135,263 @@ function sheetRows(route) {
   return rows;
 }
 
-function table(route) {
-  const t = el("table");
+function table(route, editable = false) {
+  const t = el("table", { "data-testid": "run-table", "data-vehicle": route.vehicle_id });
   const head = el("tr");
-  for (const name of SHEET_HEAD) head.appendChild(el("th", { scope: "col" }, name));
+  for (const name of [...SHEET_HEAD, ...(editable ? ["Move"] : [])]) head.appendChild(el("th", { scope: "col" }, name));
   t.appendChild(head);
-  for (const row of sheetRows(route)) {
+  const visits = visitsOf(route);
+  sheetRows(route).forEach((row, k) => {
     const tr = el("tr");
     for (const cell of row) tr.appendChild(el("td", {}, cell));
+    if (editable && visits[k].kind === "stop") tr.appendChild(moveCell(route.vehicle_id, visits[k].id, tr));
+    else if (editable) tr.appendChild(el("td"));
     t.appendChild(tr);
-  }
+  });
+  if (editable) dropTarget(t, route.vehicle_id, null);
   return t;
 }
 
 function stopTable(route) {
-  const details = el("details");
+  const details = el("details", { "data-vehicle-table": route.vehicle_id });
   details.appendChild(el("summary", {}, "Stops, charges, reloads and breaks"));
-  details.appendChild(table(route));
+  details.appendChild(table(route, true));
   return details;
+}
+
+// ---------------------------------------------------------------- editing: move, re-simulate
+
+function moveCell(vehicleId, stopId, tr) {
+  // ↑ ↓ within the route, a list of vans to move to; the row drags onto another row too.
+  const cell = el("td", { class: "move" });
+  const up = el("button", { type: "button", class: "secondary small", "aria-label": `Move ${stopId} earlier`, "data-testid": "move-up" }, "↑");
+  const down = el("button", { type: "button", class: "secondary small", "aria-label": `Move ${stopId} later`, "data-testid": "move-down" }, "↓");
+  up.addEventListener("click", () => moveStop(stopId, vehicleId, -1));
+  down.addEventListener("click", () => moveStop(stopId, vehicleId, +1));
+  const to = el("select", { "aria-label": `Van for ${stopId}`, "data-testid": "move-to" });
+  for (const route of state.routes) to.appendChild(el("option", { value: route.vehicle_id }, route.vehicle_id));
+  to.value = vehicleId;
+  to.addEventListener("change", () => moveStop(stopId, to.value, null));
+  cell.append(up, down, to);
+  tr.draggable = true;
+  tr.dataset.stop = stopId;
+  tr.addEventListener("dragstart", (event) => event.dataTransfer.setData("text/plain", stopId));
+  dropTarget(tr, vehicleId, stopId);
+  return cell;
+}
+
+function dropTarget(node, vehicleId, beforeStopId) {
+  node.addEventListener("dragover", (event) => event.preventDefault());
+  node.addEventListener("drop", (event) => {
+    event.preventDefault();
+    event.stopPropagation();
+    const moved = event.dataTransfer.getData("text/plain");
+    if (moved && moved !== beforeStopId) moveStop(moved, vehicleId, null, beforeStopId);
+  });
+}
+
+function moveStop(stopId, vehicleId, step, beforeStopId = null) {
+  // The stop to another place in a van's order: step ±1 in its own, or before a stop (or at
+  // the end) of another's.
+  const from = Object.keys(state.order).find((v) => state.order[v].includes(stopId));
+  const source = state.order[from];
+  const at = source.indexOf(stopId);
+  if (step !== null) {
+    const to = at + step;
+    if (to < 0 || to >= source.length) return;
+    source.splice(at, 1);
+    source.splice(to, 0, stopId);
+  } else {
+    source.splice(at, 1);
+    const target = state.order[vehicleId];
+    const before = beforeStopId === null ? -1 : target.indexOf(beforeStopId);
+    target.splice(before < 0 ? target.length : before, 0, stopId);
+    state.changed.add(vehicleId);
+  }
+  state.changed.add(from);
+  drawOrders();
+}
+
+function drawOrders() {
+  // A changed route's table: the new order, its times not known until re-simulated.
+  for (const vehicleId of state.changed) {
+    const holder = document.querySelector(`[data-vehicle-table="${vehicleId}"]`);
+    if (!holder) continue;
+    const t = el("table", { "data-testid": "run-table", "data-vehicle": vehicleId, class: "changed" });
+    const head = el("tr");
+    for (const name of ["#", "Stop", "Move"]) head.appendChild(el("th", { scope: "col" }, name));
+    t.appendChild(head);
+    state.order[vehicleId].forEach((stopId, k) => {
+      const tr = el("tr");
+      tr.append(el("td", {}, String(k + 1)), el("td", {}, stopId), moveCell(vehicleId, stopId, tr));
+      t.appendChild(tr);
+    });
+    dropTarget(t, vehicleId, null);
+    holder.replaceChildren(el("summary", {}, `Changed: ${state.order[vehicleId].length} stops in a new order — re-simulate for the times`), t);
+    holder.open = true;
+  }
+  $("resimulate").disabled = state.changed.size === 0;
+  $("edit-status").textContent = state.changed.size ? `${state.changed.size} route(s) changed, not yet simulated.` : "";
+}
+
+const FLEET_ONLY = ["vehicles", "minimize_vehicles", "matrix"];
+const VAN_SHIFT = ["id", "shift_start", "shift_end"];
+
+function routeRequest(vehicleId) {
+  // The plan request that re-simulates one van's stops in the order given.
+  const request = state.request;
+  const byId = Object.fromEntries(request.stops.map((x) => [x.id, x]));
+  const stops = state.order[vehicleId].map((id) => byId[id]);
+  if (state.endpoint === "plans") return { ...request, stops, keep_order: true };
+  const body = Object.fromEntries(Object.entries(request).filter(([k]) => !FLEET_ONLY.includes(k)));
+  const van = vanOf(request, vehicleId);
+  for (const [k, v] of Object.entries(van)) if (!VAN_SHIFT.includes(k)) body[k] = v;
+  if (van.shift_start) body.start_time = van.shift_start;
+  return { ...body, stops, keep_order: true, include_geometry: true, include_profile: true };
+}
+
+async function resimulate() {
+  $("resimulate").disabled = true;
+  $("edit-status").textContent = "Re-simulating…";
+  const changed = [...state.changed].filter((v) => state.order[v].length);
+  const answers = {};
+  for (const vehicleId of changed) {
+    const answer = await api("POST", "/v1/plans", routeRequest(vehicleId));
+    if (!answer.ok) {
+      $("edit-status").textContent = "";
+      $("resimulate").disabled = false;
+      const problem = answer.data || {};
+      const detail = (problem.errors || []).map((e) => `${e.field}: ${e.message}`).join("; ") || problem.detail;
+      showError(`${vehicleId} in the new order: ${detail || `the service answered ${answer.status}`}`);
+      return;
+    }
+    answers[vehicleId] = answer.data;
+  }
+  if (state.endpoint === "plans") {
+    const request = routeRequest("van");
+    show(request, "plans", answers.van, null, "edited");
+    return;
+  }
+  const routes = state.routes
+    .filter((r) => state.order[r.vehicle_id].length)
+    .map((r) => (answers[r.vehicle_id] ? { ...answers[r.vehicle_id], vehicle_id: r.vehicle_id } : r));
+  const edited = { ...state.answer, routes, edited: true };
+  show(state.request, "fleet-plans", edited, null, "edited");
+}
+
+// ---------------------------------------------------------------- save and compare
+
+function remember(request, endpoint, answer, jobId, label) {
+  const routes = routesOf(endpoint, answer);
+  const served = routes.reduce((n, r) => n + r.stops.length, 0);
+  const name = `Plan ${state.history.length + 1}${label ? ` (${label})` : ""}${jobId ? ` · job ${jobId.slice(0, 8)}` : ""}: ` +
+    `${served} stops, ${km(routes.reduce((n, r) => n + r.totals.distance_m, 0))}`;
+  state.history.push({ name, request, endpoint, answer });
+}
+
+function drawWork() {
+  $("work-card").hidden = false;
+  const link = $("saved-link");
+  // A fleet changed by hand is no longer one request: saved route by route, not as a whole.
+  $("save").disabled = Boolean(state.answer.edited);
+  if (state.jobId) showLink(state.jobId);
+  else link.hidden = true;
+  drawOrders();
+  for (const id of ["compare-a", "compare-b"]) {
+    const select = $(id);
+    select.replaceChildren(...state.history.map((h, k) => el("option", { value: String(k) }, h.name)));
+  }
+  $("compare-a").value = String(Math.max(state.history.length - 2, 0));
+  $("compare-b").value = String(state.history.length - 1);
+  drawCompare();
+}
+
+function showLink(jobId) {
+  const link = $("saved-link");
+  link.href = `/viewer?job=${encodeURIComponent(jobId)}`;
+  link.textContent = `${window.location.origin}${link.getAttribute("href")}`;
+  link.hidden = false;
+}
+
+async function save() {
+  // Saved in the jobs' store: the same request planned again gives the same plan (seeded,
+  // stopped by work), kept as long as jobs are (COLDROUTE_JOB_RETENTION_S).
+  const submitted = await api("POST", "/v1/jobs", {
+    type: state.endpoint === "plans" ? "plan" : "fleet-plan", request: state.request,
+  });
+  if (!submitted.ok) { showProblem(submitted.data, submitted.status); return; }
+  state.jobId = submitted.data.id;
+  showLink(submitted.data.id);
+  $("edit-status").textContent = "Saved: the link reopens this plan.";
+}
+
+function lateMinutes(routes, places) {
+  // Minutes served after the end of a stop's window, over the day.
+  let late = 0;
+  for (const route of routes) {
+    for (const stop of route.stops) {
+      const windows = (places[stop.id] || {}).time_windows || [];
+      if (!windows.length) continue;
+      const clock = stop.service_start ? stop.service_start.slice(11, 16) : stop.arrival.slice(11, 16);
+      const toMin = (hhmm) => Number(hhmm.slice(0, 2)) * 60 + Number(hhmm.slice(3, 5));
+      const over = Math.min(...windows.map((w) => Math.max(toMin(clock) - toMin(w.end), 0)));
+      late += over;
+    }
+  }
+  return late;
+}
+
+function figures(plan) {
+  const routes = routesOf(plan.endpoint, plan.answer);
+  const places = Object.fromEntries(((plan.request && plan.request.stops) || []).map((x) => [x.id, x]));
+  const sum = (f) => routes.reduce((n, r) => n + f(r), 0);
+  const chains = routes.filter((r) => r.cold_chain);
+  const broken = chains.filter((r) => r.cold_chain.verdict === "breaks").length;
+  return [
+    ["Vans", String(routes.length)],
+    ["Stops served", String(sum((r) => r.stops.length))],
+    ["Not served", String(plan.endpoint === "plans" ? 0 : (plan.answer.unassigned || []).length)],
+    ["Distance", km(sum((r) => r.totals.distance_m))],
+    ["Energy", kwh(sum((r) => r.totals.energy_kwh.total))],
+    ["From the grid", kwh(sum(gridKwh))],
+    ["Lowest SoC", percent(Math.min(...routes.map((r) => r.battery.min_soc)))],
+    ["Late (after the window)", `${fixed(lateMinutes(routes, places), 0)} min`],
+    ["Cold chain", chains.length ? (broken ? `breaks on ${broken} of ${chains.length}` : "holds") : "no product"],
+  ];
+}
+
+function drawCompare() {
+  const t = $("compare");
+  t.replaceChildren();
+  const a = state.history[Number($("compare-a").value)];
+  const b = state.history[Number($("compare-b").value)];
+  if (!a || !b) return;
+  const head = el("tr");
+  head.append(el("th", { scope: "col" }, ""), el("th", { scope: "col" }, a.name), el("th", { scope: "col" }, b.name));
+  t.appendChild(head);
+  const fa = figures(a);
+  const fb = figures(b);
+  fa.forEach(([name, va], k) => {
+    const tr = el("tr", va === fb[k][1] ? {} : { class: "differs" });
+    tr.append(el("th", { scope: "row" }, name), el("td", {}, va), el("td", {}, fb[k][1]));
+    t.appendChild(tr);
+  });
+}
+
+async function openToCompare() {
+  // A saved plan (its link or job id) added to the plans to compare.
+  const raw = $("compare-link").value.trim();
+  const match = /job=([^&\s]+)/.exec(raw);
+  const jobId = match ? decodeURIComponent(match[1]) : raw;
+  if (!jobId) return;
+  const answer = await api("GET", `/v1/jobs/${encodeURIComponent(jobId)}?include_request=true`);
+  if (!answer.ok || answer.data.status !== "succeeded") {
+    showError(`Compare: ${answer.ok ? `job ${jobId} is ${answer.data.status}` : `no saved plan ${jobId} (${answer.status})`}.`);
+    return;
+  }
+  const job = answer.data;
+  remember(job.request, job.type === "plan" ? "plans" : "fleet-plans", job.result, job.id, "saved");
+  drawWork();
 }
 
 function printRunSheet(route) {
@@ -1241,6 +1492,11 @@ async function start() {
   });
   $("export-csv").addEventListener("click", exportCsv);
   $("export-geojson").addEventListener("click", exportGeojson);
+  $("save").addEventListener("click", () => save().catch((error) => showError(`Unexpected: ${error.message}`)));
+  $("resimulate").addEventListener("click", () => resimulate().catch((error) => showError(`Unexpected: ${error.message}`)));
+  $("compare-a").addEventListener("change", drawCompare);
+  $("compare-b").addEventListener("change", drawCompare);
+  $("compare-open").addEventListener("click", () => openToCompare().catch((error) => showError(`Unexpected: ${error.message}`)));
   await loadVans();
   if (job) follow(job, null, null);
 }
@@ -1262,6 +1518,7 @@ window.coldroute = {
   charts: () => [...document.querySelectorAll("figure.chart")].filter((f) => f.plot).map((f) => ({
     testid: f.dataset.testid, vehicle: f.dataset.vehicle,
     series: f.plot.series.slice(1).map((s) => s.label), points: f.plot.data[0].length,
+    start: f.plot.series[0].value(f.plot, f.plot.data[0][0]),
   })),
 };
 

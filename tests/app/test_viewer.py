@@ -161,6 +161,23 @@ def test_a_csv_day_for_three_vans_on_the_map_and_in_the_charts(server, page, tmp
         assert tab.get_by_test_id(name).count() == len(routes)
     legend = tab.get_by_test_id("map-legend").inner_text()
     assert all(r["vehicle_id"] in legend for r in routes) and "not served" in legend
+    # a route's card, line and legend entry lit together; the other routes fade
+    first = routes[0]["vehicle_id"]
+    tab.get_by_test_id("route").first.hover()
+    lines = tab.get_by_test_id("route-line")
+    faded = {
+        lines.nth(k).get_attribute("data-vehicle"): lines.nth(k).get_attribute("stroke-opacity")
+        for k in range(lines.count())
+    }
+    assert faded == {
+        r["vehicle_id"]: "0.85" if r["vehicle_id"] == first else "0.15" for r in routes
+    }
+    assert "active" in (
+        tab.locator(f".legend-route[data-vehicle='{first}']").get_attribute("class")
+    )
+    shot(tab, "2b-one-route-lit")
+    tab.get_by_test_id("export-csv").hover()
+    expect(lines.last).to_have_attribute("stroke-opacity", "0.85")
     unassigned = tab.get_by_test_id("unassigned")
     assert unassigned.count() == 1
     assert TOO_HEAVY in unassigned.inner_text() and "capacity" in unassigned.inner_text()
@@ -323,3 +340,253 @@ def test_a_pasted_plan_on_real_roads_draws_the_roads_and_a_run_sheet(osrm_url, t
             assert outside == [] and errors == []
     finally:
         roads.close()
+
+
+# --- a dispatcher's own CSV, its assumptions and its errors in view ---------------------------
+
+DISPATCH_HEADER = "id,lat,lon,service_min,door_min,kg,window_start,window_end,address,notes"
+
+
+def dispatch_csv(rows: list[str]) -> str:
+    return "\r\n".join([DISPATCH_HEADER, *rows]) + "\r\n"
+
+
+#: Six shops as a dispatcher's export has them: an address and notes beside the columns the
+#: viewer reads, windows as H:MM and HH:MM:SS; one opens only at 11:00, long after the van
+#: could be there (the van waits).
+DISPATCH_ROWS = [
+    "shop-a,48.2006,16.3862,6,2,30,7:00,10:00,Praterstraße 1,ring twice",
+    "shop-b,48.1951,16.3712,6,2,30,,,Landstraßer Hauptstraße 9,",
+    "shop-c,48.2101,16.3589,6,2,30,06:30:00,12:00:00,Wipplingerstraße 3,back door",
+    "shop-d,48.1845,16.4012,6,2,30,,,Simmeringer Hauptstraße 5,",
+    "shop-e,48.1762,16.4150,6,2,30,11:00,11:30,Geiselbergstraße 2,opens at 11",
+    "shop-f,48.2150,16.4100,6,2,30,,,Ausstellungsstraße 7,",
+]
+
+
+def plan_day(tab: Page, csv_text: str, tmp_path: Path, name: str, vans: int = 1) -> None:
+    fill_day(tab, csv_text, vans, tmp_path, name)
+    tab.get_by_test_id("plan").click()
+
+
+def test_a_dispatchers_csv_keeps_its_columns_and_the_run_sheet_reads_as_a_day(
+    server, page, tmp_path
+):
+    tab, outside = page
+    tab.goto(f"{server.url}/viewer")
+    tab.fill("#t-min", "-8")  # a winter day: the door lets cold in, never "-0.00"
+    tab.fill("#t-max", "-2")
+    plan_day(tab, dispatch_csv(DISPATCH_ROWS), tmp_path, "dispatch.csv")
+    expect(tab.get_by_test_id("route-line")).to_have_count(1, timeout=60_000)
+    answer = tab.evaluate("window.coldroute.answer()")
+    # the plan's assumptions in view: the weather given, straight lines and the speeds assumed
+    assumptions = tab.get_by_test_id("assumptions").inner_text()
+    route = answer["routes"][0]
+    assert f"{route['weather']['t_min_c']:.1f} to {route['weather']['t_max_c']:.1f} °C" in (
+        assumptions
+    )
+    assert "straight lines" in assumptions and "km/h" in assumptions
+    assert "1 × preset ev-van-3.5t-reefer" in assumptions
+    # the run sheet: every stop with its address and notes, the wait for shop-e's window
+    # and its service start, kg to unload; no negative zero anywhere
+    tab.get_by_test_id("route").locator("details summary").click()
+    sheet = tab.get_by_test_id("route").get_by_test_id("run-table")
+    text = sheet.inner_text()
+    for row in DISPATCH_ROWS:
+        shop, *_, address, notes = row.split(",")
+        assert address in text and notes in text
+    late = next(s for s in route["stops"] if s["id"] == "shop-e")
+    assert late["wait_s"] > 60 and late["service_start"][11:16] == "11:00"
+    cells = sheet.locator("tr", has_text="shop-e").locator("td").all_inner_texts()
+    assert cells[4] == f"{late['wait_s'] / 60:.0f} min" and cells[5] == "11:00"
+    assert cells[7] == "30 kg"
+    assert "-0" not in text and "−0" not in text
+    shot(tab, "9-dispatch-day")
+    # the kept columns go out with the CSV export
+    with tab.expect_download() as download:
+        tab.get_by_test_id("export-csv").click()
+    rows = list(csv.DictReader(io.StringIO(Path(download.value.path()).read_text())))
+    assert {r["stop_id"]: r["address"] for r in rows}["shop-c"] == "Wipplingerstraße 3"
+    assert outside == []
+
+
+def test_a_failed_csv_after_a_good_plan_clears_it_and_says_why_in_view(server, page, tmp_path):
+    tab, _ = page
+    tab.goto(f"{server.url}/viewer")
+    plan_day(tab, dispatch_csv(DISPATCH_ROWS), tmp_path, "good.csv")
+    expect(tab.get_by_test_id("route-line")).to_have_count(1, timeout=60_000)
+    bad = dispatch_csv([*DISPATCH_ROWS[:2], "shop-x,48.2,16.37,5,2,10,9 am,10:00,,"])
+    tab.get_by_test_id("stops-csv").set_input_files(
+        files=[{"name": "bad.csv", "mimeType": "text/csv", "buffer": bad.encode()}]
+    )
+    tab.get_by_test_id("plan").click()
+    error = tab.get_by_test_id("error").first
+    expect(error).to_contain_text("Row 3")
+    expect(error).to_be_in_viewport()
+    # the earlier plan is gone: nothing on the map, no route, nothing to export
+    assert tab.get_by_test_id("route-line").count() == 0
+    assert tab.get_by_test_id("route").count() == 0
+    expect(tab.get_by_test_id("export-csv")).to_be_disabled()
+    assert tab.evaluate("window.coldroute.answer()") is None
+    shot(tab, "10-failed-after-good")
+
+
+def test_swapped_coordinates_are_refused_and_a_far_stop_is_flagged_and_warned(
+    server, page, tmp_path
+):
+    tab, _ = page
+    tab.goto(f"{server.url}/viewer")
+    swapped = [*DISPATCH_ROWS[:3], "shop-s,16.3950,48.2050,6,2,30,,,Taborstraße 8,"]
+    plan_day(tab, dispatch_csv(swapped), tmp_path, "swapped.csv")
+    error = tab.get_by_test_id("error").first
+    expect(error).to_contain_text("Row 4")
+    assert "look swapped" in error.inner_text() and "shop-s" in error.inner_text()
+    assert tab.get_by_test_id("route-line").count() == 0
+    # Berlin, some 520 km from the Vienna depot: planned, flagged before and warned after
+    berlin = [*DISPATCH_ROWS[:3], "shop-berlin,52.5200,13.4050,6,2,30,,,Unter den Linden 1,"]
+    tab.get_by_test_id("stops-csv").set_input_files(
+        files=[{"name": "far.csv", "mimeType": "text/csv", "buffer": dispatch_csv(berlin).encode()}]
+    )
+    tab.get_by_test_id("plan").click()
+    expect(tab.get_by_test_id("route-line").first).to_be_visible(timeout=60_000)
+    flagged = tab.get_by_test_id("flag").first.inner_text()
+    assert "Row 4" in flagged and "shop-berlin" in flagged and "km from the depot" in flagged
+    warned = tab.get_by_test_id("warnings").inner_text()
+    assert "'shop-berlin') is 5" in warned and "from the depot" in warned
+    shot(tab, "11-far-stop")
+
+
+def test_charts_read_the_plans_local_clock_whatever_the_browsers_zone(server, tmp_path):
+    options = {"viewport": {"width": 1500, "height": 1100}, "timezone_id": "America/New_York"}
+    with offline_tab(server.url, **options) as (tab, outside, errors):
+        tab.goto(f"{server.url}/viewer")
+        plan_day(tab, dispatch_csv(DISPATCH_ROWS), tmp_path, "clock.csv")
+        expect(tab.get_by_test_id("route-line")).to_have_count(1, timeout=60_000)
+        leaves = tab.evaluate("window.coldroute.answer()")["routes"][0]["legs"][0]["depart"]
+        charts = tab.evaluate("window.coldroute.charts()")
+        assert {c["start"] for c in charts} == {leaves[11:16]}  # Vienna's, not New York's
+        assert errors == [] and outside == []
+
+
+def test_tiles_that_cannot_be_loaded_leave_a_note_not_broken_images(tmp_path):
+    tiles = "http://tiles.invalid/{z}/{x}/{y}.png"
+    served = Server({"COLDROUTE_WORKERS": "1", "COLDROUTE_TILE_URL": tiles}).start()
+    try:
+        with offline_tab(served.url, viewport={"width": 1500, "height": 1100}) as (
+            tab,
+            outside,
+            errors,
+        ):
+            tab.goto(f"{served.url}/viewer")
+            note = tab.get_by_test_id("map-note")
+            expect(note).to_contain_text("could not be loaded from tiles.invalid")
+            assert tab.locator("img.leaflet-tile").count() == 0
+            assert outside and all(url.startswith("http://tiles.invalid/") for url in outside)
+            assert tab.get_by_test_id("scale-bar").is_visible()
+            shot(tab, "12-no-tiles")
+            assert errors == []
+    finally:
+        served.close()
+
+
+AXE = Path(__file__).parent / "vendor" / "axe-core" / "axe.min.js"  # axe-core 4.14.1, MPL-2.0
+
+
+def test_the_page_is_keyboard_operable_and_axe_finds_nothing_serious(server, tmp_path):
+    # the CSP is bypassed only to inject axe-core itself (vendored beside the tests); a
+    # screen of twice the pixels, as a laptop's (the screenshot shows the charts at 2×)
+    options = {"viewport": {"width": 1500, "height": 1100}, "bypass_csp": True}
+    options["device_scale_factor"] = 2
+    with offline_tab(server.url, **options) as (tab, outside, errors):
+        tab.goto(f"{server.url}/viewer")
+        # keyboard only: the key, then Tab through the form to the Plan button
+        tab.get_by_test_id("api-key").focus()
+        tab.keyboard.type(KEY)
+        tab.keyboard.press("Tab")
+        fill_day(tab, dispatch_csv(DISPATCH_ROWS), 2, tmp_path, "keys.csv")
+        tab.get_by_test_id("plan").focus()
+        tab.keyboard.press("Enter")
+        expect(tab.get_by_test_id("route-line").first).to_be_visible(timeout=60_000)
+        # a stop marker takes the focus and names itself
+        marker = tab.locator(".leaflet-marker-icon[role=button]").first
+        marker.focus()
+        assert tab.evaluate("document.activeElement.getAttribute('aria-label')")
+        tab.add_script_tag(path=str(AXE))
+        found = tab.evaluate(
+            "axe.run(document, {resultTypes: ['violations']})"
+            ".then(r => r.violations.map(v => ({id: v.id, impact: v.impact, nodes: v.nodes.length,"
+            " target: v.nodes[0].target.join(' ')})))"
+        )
+        serious = [v for v in found if v["impact"] in ("serious", "critical")]
+        assert serious == [], serious
+        shot(tab, "13-keyboard-2x")
+        assert errors == [] and outside == []
+
+
+# --- working with a plan: save and reopen, move a stop and re-simulate, compare ---------------
+
+
+def test_a_plan_saved_reopens_by_its_link_and_a_moved_stop_is_re_simulated_and_compared(
+    server, page, tmp_path
+):
+    tab, outside = page
+    tab.goto(f"{server.url}/viewer")
+    fill_day(tab, dispatch_csv(DISPATCH_ROWS), 2, tmp_path, "work.csv")
+    tab.fill("#payload-kg", "120")  # 180 kg of deliveries: both vans drive
+    tab.get_by_test_id("plan").click()
+    expect(tab.get_by_test_id("route-line").first).to_be_visible(timeout=60_000)
+    first = tab.evaluate("window.coldroute.answer()")
+    assert len(first["routes"]) == 2, "the day needs both vans for this test"
+    # from the fuller van to the other, which has room for 30 kg more
+    routes = sorted(first["routes"], key=lambda r: -len(r["stops"]))
+    # saved: a link that reopens the same plan (the same request planned again, as a job)
+    tab.get_by_test_id("save").click()
+    link = tab.get_by_test_id("saved-link")
+    expect(link).to_be_visible(timeout=30_000)
+    href = link.get_attribute("href")
+    assert href.startswith("/viewer?job=")
+
+    # the last stop of the first van moved to the second van's front, by keyboard and list
+    moved = routes[0]["stops"][-1]["id"]
+    tab.locator(f"[data-testid=route][data-vehicle='{routes[0]['vehicle_id']}'] summary").click()
+    row = tab.locator(f"table[data-vehicle='{routes[0]['vehicle_id']}'] tr[data-stop='{moved}']")
+    row.get_by_test_id("move-to").select_option(routes[1]["vehicle_id"])
+    target = tab.locator(f"table[data-vehicle='{routes[1]['vehicle_id']}'] tr[data-stop]")
+    expect(target.last).to_have_attribute("data-stop", moved)
+    mine = tab.locator(f"table[data-vehicle='{routes[1]['vehicle_id']}'] tr[data-stop='{moved}']")
+    for _ in range(len(routes[1]["stops"])):
+        mine.get_by_test_id("move-up").click()  # to the front, one place at a time
+    expect(target.first).to_have_attribute("data-stop", moved)
+    expect(tab.get_by_test_id("edit-status")).to_contain_text("2 route(s) changed")
+    tab.get_by_test_id("resimulate").click()
+    expect(tab.get_by_test_id("compare")).to_contain_text("(edited)", timeout=60_000)
+    assert tab.get_by_test_id("error").count() == 0
+    edited = tab.evaluate("window.coldroute.answer()")
+    after = {r["vehicle_id"]: r for r in edited["routes"]}
+    assert [s["id"] for s in after[routes[1]["vehicle_id"]]["stops"]] == [moved] + [
+        s["id"] for s in routes[1]["stops"]
+    ]
+    assert moved not in [s["id"] for s in after[routes[0]["vehicle_id"]]["stops"]]
+    # each changed route planned in the order given (keep_order), and simulated in full
+    assert {r["solver"]["status"] for r in edited["routes"]} == {"fixed_order"}
+    assert tab.get_by_test_id("route-line").count() == 2
+    # the two plans side by side: the one planned and the one edited by hand
+    table = tab.get_by_test_id("compare")
+    expect(table).to_contain_text("Plan 1")
+    expect(table).to_contain_text("(edited)")
+    distance = table.locator("tr", has_text="Distance").locator("td").all_inner_texts()
+    total_km = sum(r["totals"]["distance_m"] for r in edited["routes"]) / 1000
+    assert distance[1] == f"{total_km:.1f} km" and distance[0] != distance[1]
+    shot(tab, "14-edited-and-compared")
+
+    # a colleague opens the saved link: the first plan, as it was
+    tab.goto(f"{server.url}{href}")
+    tab.get_by_test_id("api-key").fill(KEY)
+    tab.get_by_test_id("api-key").dispatch_event("change")
+    expect(tab.get_by_test_id("route-line").first).to_be_visible(timeout=60_000)
+    reopened = tab.evaluate("window.coldroute.answer()")
+    assert reopened["routes"] == first["routes"] or [
+        [s["id"] for s in r["stops"]] for r in reopened["routes"]
+    ] == [[s["id"] for s in r["stops"]] for r in first["routes"]]
+    shot(tab, "15-saved-reopened")
+    assert outside == []
