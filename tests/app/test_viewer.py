@@ -393,7 +393,7 @@ def test_a_dispatchers_csv_keeps_its_columns_and_the_run_sheet_reads_as_a_day(
     sheet = tab.get_by_test_id("route").get_by_test_id("run-table")
     text = sheet.inner_text()
     for row in DISPATCH_ROWS:
-        shop, *_, address, notes = row.split(",")
+        *_, address, notes = row.split(",")
         assert address in text and notes in text
     late = next(s for s in route["stops"] if s["id"] == "shop-e")
     assert late["wait_s"] > 60 and late["service_start"][11:16] == "11:00"
