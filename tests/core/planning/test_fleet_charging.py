@@ -26,6 +26,7 @@ from core.planning.day.verify import Failure
 from core.planning.fleet.planner import _failure, _given_to_idle, plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
 from core.planning.search.feasibility import Feasibility
+from core.routing.effort import Effort
 from tests.core.planning.test_breaks import driving_between_breaks_s
 from tests.core.planning.test_recharge import summer_day
 from tests.utils.fleets import DEPOT
@@ -271,10 +272,16 @@ def test_stops_left_out_share_one_idle_van_where_its_round_holds():
     results = {0: day.simulate(0, routes[0])}
     budgets = [day.estimates[v].budget_j for v in day.vans]
     rules = Feasibility(day, day.duration_s.astype(np.int64), budgets)
-    refused = _given_to_idle(day, rules, routes, results)  # 1 and 3 are left out
-    assert not refused
+    plenty = Effort.starting_now(1.0, 60.0)
+    refused, cut = _given_to_idle(day, rules, routes, results, plenty)  # 1 and 3 left out
+    assert not refused and not cut
     assert sorted(routes[1]) == [1, 3] and routes[2] == []
     assert _failure(day, 1, results[1]) is None  # its simulation holds
+    # past the search's deadline nothing more is tried, and it says the time limit cut it
+    routes = [[4, 5, 6, 2], [], []]
+    over = Effort.starting_now(1.0, 0.0)
+    refused, cut = _given_to_idle(day, rules, routes, {0: results[0]}, over)
+    assert cut and not refused and routes[1] == routes[2] == []
 
 
 @pytest.mark.parametrize(
