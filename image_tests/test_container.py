@@ -42,6 +42,14 @@ def test_healthy_answers_plans_as_non_root_and_logs_json_lines(run_container):
         plan = http.post("/v1/plans", json=example("/v1/plans", "vienna-8-stops"))
         fleet = http.post("/v1/fleet-plans", json=example("/v1/fleet-plans", "vienna-two-vans"))
         health = http.get("/healthz")
+        # the viewer and the libraries vendored beside it, from the image's own files
+        viewer = http.get("/viewer")
+        libraries = [
+            http.get(f"/viewer/static/vendor/{path}")
+            for path in ("leaflet/leaflet.js", "leaflet/LICENSE", "uplot/uPlot.iife.min.js")
+        ]
+    assert viewer.status_code == 200 and "leaflet.js" in viewer.text
+    assert [r.status_code for r in libraries] == [200, 200, 200]
     assert plan.status_code == 200, plan.text
     assert len(plan.json()["stops"]) == 8 and plan.json()["battery"]["feasible"]
     assert fleet.status_code == 200, fleet.text
