@@ -132,8 +132,8 @@ class VehicleParams(Params):
     )
 
 
-class CargoBoxParams(Params):
-    """The insulated cargo box and its refrigeration unit (paper §3)."""
+class BoxGeometry(Params):
+    """The insulated box's size and walls (paper §3, Table 1)."""
 
     volume_m3: float = Field(8.0, ge=0.1, le=100, description="Inner volume V [m³] (Table 1).")
     wall_heat_transfer_w_m2k: float = Field(
@@ -162,6 +162,40 @@ class CargoBoxParams(Params):
         description="Total heat-transfer area A [m²] (eq. 11); null means 2·(A_r + A_s + A_b); at "
         "least 0.1 m².",
     )
+
+    @property
+    def heat_transfer_area_m2(self) -> float:
+        """Wall area A [m²] used in eq. 11."""
+        if self.wall_area_m2 is not None:
+            return self.wall_area_m2
+        return 2.0 * (self.roof_area_m2 + self.side_area_m2 + self.back_area_m2)
+
+
+class SwitchingUnit(Params):
+    """How a fixed-speed (on-off) unit switches: its thermostat's differential and its
+    shortest run and pause."""
+
+    differential_k: float = Field(
+        2.0,
+        ge=0.2,
+        le=10,
+        description="An on-off unit's switching differential [K]: on at the set-point plus "
+        "half of it, off at the set-point less half.",
+    )
+    min_on_minutes: float = Field(
+        3.0, ge=0, le=120, description="An on-off unit's shortest run [min] (compressor wear)."
+    )
+    min_off_minutes: float = Field(
+        3.0,
+        ge=0,
+        le=120,
+        description="An on-off unit's shortest pause [min] (pressures equalise before a start).",
+    )
+
+
+class CargoBoxParams(BoxGeometry, SwitchingUnit):
+    """The insulated cargo box, its goods and its refrigeration unit (paper §3)."""
+
     product: Product | None = Field(
         None,
         description="What the box carries: a class with its legal band (frozen, ice-cream: "
@@ -322,22 +356,6 @@ class CargoBoxParams(Params):
         "switched by a thermostat with differential_k, each run and each pause at least "
         "min_on_minutes and min_off_minutes). 'on-off' needs the dynamic mode and a product.",
     )
-    differential_k: float = Field(
-        2.0,
-        ge=0.2,
-        le=10,
-        description="An on-off unit's switching differential [K]: on at the set-point plus "
-        "half of it, off at the set-point less half.",
-    )
-    min_on_minutes: float = Field(
-        3.0, ge=0, le=120, description="An on-off unit's shortest run [min] (compressor wear)."
-    )
-    min_off_minutes: float = Field(
-        3.0,
-        ge=0,
-        le=120,
-        description="An on-off unit's shortest pause [min] (pressures equalise before a start).",
-    )
 
     @classmethod
     def changed_values(cls, current: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
@@ -417,13 +435,6 @@ class CargoBoxParams(Params):
         if "setpoint_c" in info.data and value <= info.data["setpoint_c"]:
             raise ValueError("product_limit_c must be above setpoint_c")
         return value
-
-    @property
-    def heat_transfer_area_m2(self) -> float:
-        """Wall area A [m²] used in eq. 11."""
-        if self.wall_area_m2 is not None:
-            return self.wall_area_m2
-        return 2.0 * (self.roof_area_m2 + self.side_area_m2 + self.back_area_m2)
 
 
 #: Smallest usable state-of-charge window ``initial_soc − min_soc`` [–].

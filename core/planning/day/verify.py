@@ -318,31 +318,6 @@ class _Split:
             visit("break", self.order[min(k, len(self.order) - 1)], b, b, c, k)
         return sorted(out, key=lambda v: (v.arrive, v.depart))
 
-    def profile(self) -> DayProfile:
-        size = self.simulated.time_s.size
-        every = max(round(PROFILE_STEP_S / PLAN_DT_S), 1)
-        picks = np.unique(np.append(np.arange(0, size, every), size - 1))
-        kwh = {name: (c[picks] / JOULES_PER_KWH).tolist() for name, c in self.cumulative_j.items()}
-        kwh["total"] = np.sum([kwh[name] for name in CONSUMERS], axis=0).tolist()
-        simulated_box = self.simulated.box
-        # the box's temperatures are at the end of each step: sample i ends step i - 1
-        steps = np.maximum(picks - 1, 0)
-        box: list[float] | None = None
-        if self.problem.van.cargo_box.mode == "dynamic":
-            box = simulated_box.temperature_c[steps].tolist()
-        goods = simulated_box.product_c
-        setpoint = simulated_box.setpoint_c
-        return DayProfile(
-            time=[self.moment(int(i)) for i in picks],
-            energy_kwh=kwh,
-            soc=self.simulated.soc[picks].tolist(),
-            box_temperature_c=box,
-            product_temperature_c=None
-            if goods is None
-            else [None if math.isnan(v) else v for v in goods[steps].tolist()],
-            air_setpoint_c=None if setpoint is None else setpoint[steps].tolist(),
-        )
-
     def result(self, solved: Solved, warnings: list[str]) -> PlanResult:
         simulated, places, legs = self.simulated, self.scene.places, self.scene.legs
         total = simulated.energy_kwh["total"]
@@ -380,7 +355,7 @@ class _Split:
             depot_snap_distance_m=None if snap is None else float(snap[0]),
             solved=solved,
             objective=self.problem.objective,
-            profile=self.profile(),
+            profile=_profile(self),
             late_stops=[places[j].id for j in self.timeline.late],
             itinerary=self.itinerary,
             charges=self.charges(),
@@ -397,6 +372,34 @@ class _Split:
                 for b in self.timeline.breaks
             ],
         )
+
+
+def _profile(split: _Split) -> DayProfile:
+    """The day minute by minute: each consumer's energy since departure, the state of
+    charge, the box's air and the goods, the unit's set-point."""
+    size = split.simulated.time_s.size
+    every = max(round(PROFILE_STEP_S / PLAN_DT_S), 1)
+    picks = np.unique(np.append(np.arange(0, size, every), size - 1))
+    kwh = {name: (c[picks] / JOULES_PER_KWH).tolist() for name, c in split.cumulative_j.items()}
+    kwh["total"] = np.sum([kwh[name] for name in CONSUMERS], axis=0).tolist()
+    simulated_box = split.simulated.box
+    # the box's temperatures are at the end of each step: sample i ends step i - 1
+    steps = np.maximum(picks - 1, 0)
+    box: list[float] | None = None
+    if split.problem.van.cargo_box.mode == "dynamic":
+        box = simulated_box.temperature_c[steps].tolist()
+    goods = simulated_box.product_c
+    setpoint = simulated_box.setpoint_c
+    return DayProfile(
+        time=[split.moment(int(i)) for i in picks],
+        energy_kwh=kwh,
+        soc=split.simulated.soc[picks].tolist(),
+        box_temperature_c=box,
+        product_temperature_c=None
+        if goods is None
+        else [None if math.isnan(v) else v for v in goods[steps].tolist()],
+        air_setpoint_c=None if setpoint is None else setpoint[steps].tolist(),
+    )
 
 
 @dataclass(frozen=True)
