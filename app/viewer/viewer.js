@@ -33,6 +33,8 @@ const state = {
   columns: [], charts: [], jobId: null,
   // The plans shown in this page, to compare; and the stops' order per van as edited.
   history: [], order: {}, changed: new Set(),
+  // Stops pinned to a van for the next re-plan of the fleet: stop id → van id.
+  pins: {},
 };
 let polling = null;
 let map = null;
@@ -416,9 +418,14 @@ async function plan(event) {
     if (error instanceof CsvError) { clearPlan(); showError(error.message); return; }
     throw error;
   }
-  const endpoint = Array.isArray(body.vehicles) ? "fleet-plans" : "plans";
+  await submit(body);
+}
+
+async function submit(request, label = null) {
+  // Planned at once when small and quick, else as a job followed to its end.
+  const endpoint = Array.isArray(request.vehicles) ? "fleet-plans" : "plans";
   // What the viewer draws: the roads (where a router gives them) and the day minute by minute.
-  body = { ...body, include_geometry: true, include_profile: true };
+  const body = { ...request, include_geometry: true, include_profile: true };
   const limit = body.time_limit_s ?? 1;
   if (body.stops.length > SYNC_MAX_STOPS || limit > SYNC_MAX_TIME_LIMIT_S) {
     const submitted = await api("POST", "/v1/jobs", {
@@ -435,7 +442,7 @@ async function plan(event) {
     const answer = await api("POST", `/v1/${endpoint}`, body);
     if (!answer.ok) { $("status").textContent = ""; showProblem(answer.data, answer.status); return; }
     $("status").textContent = "Planned.";
-    show(body, endpoint, answer.data);
+    show(body, endpoint, answer.data, null, label);
   } finally {
     $("plan").disabled = false;
   }
@@ -529,6 +536,10 @@ function show(request, endpoint, answer, jobId = null, label = null) {
   state.jobId = jobId;
   state.routes = routesOf(endpoint, answer);
   state.order = Object.fromEntries(state.routes.map((r) => [r.vehicle_id, r.stops.map((x) => x.id)]));
+  state.pins = {};
+  for (const van of (request && request.vehicles) || []) {
+    for (const stopId of van.pinned_stops || []) state.pins[stopId] = van.id;
+  }
   remember(request, endpoint, answer, jobId, label);
   state.places = {};
   if (request) {
@@ -1173,11 +1184,47 @@ function moveCell(vehicleId, stopId, tr) {
   to.value = vehicleId;
   to.addEventListener("change", () => moveStop(stopId, to.value, null));
   cell.append(up, down, to);
+  if (state.endpoint === "fleet-plans") cell.appendChild(pinButton(stopId, vehicleId));
   tr.draggable = true;
   tr.dataset.stop = stopId;
   tr.addEventListener("dragstart", (event) => event.dataTransfer.setData("text/plain", stopId));
   dropTarget(tr, vehicleId, stopId);
   return cell;
+}
+
+function pinButton(stopId, vehicleId) {
+  // Pinned: the fleet's re-plan gives the stop to this van (or leaves it out, saying why).
+  const pinned = state.pins[stopId] === vehicleId;
+  const pin = el("button", {
+    type: "button", class: "secondary small", "data-testid": "pin", "aria-pressed": String(pinned),
+    "aria-label": `Pin ${stopId} to ${vehicleId}`, title: `Pin ${stopId} to ${vehicleId} when the fleet is planned again`,
+  }, pinned ? "📌 pinned" : "pin");
+  pin.addEventListener("click", () => {
+    if (state.pins[stopId] === vehicleId) delete state.pins[stopId];
+    else state.pins[stopId] = vehicleId;
+    pin.setAttribute("aria-pressed", String(state.pins[stopId] === vehicleId));
+    pin.textContent = state.pins[stopId] === vehicleId ? "📌 pinned" : "pin";
+    drawPins();
+  });
+  return pin;
+}
+
+function drawPins() {
+  const count = Object.keys(state.pins).length;
+  $("replan").hidden = state.endpoint !== "fleet-plans";
+  $("replan").disabled = count === 0;
+  $("pin-status").textContent = count ? `${count} stop(s) pinned: ${Object.entries(state.pins).map(([s, v]) => `${s} → ${v}`).join(", ")}.` : "";
+}
+
+async function replan() {
+  // The fleet's request again, each van with the stops pinned to it: the search plans the
+  // rest around them.
+  const request = structuredClone(state.request);
+  for (const van of request.vehicles) {
+    van.pinned_stops = Object.keys(state.pins).filter((stopId) => state.pins[stopId] === van.id);
+  }
+  clearMessages();
+  await submit(request, "pinned");
 }
 
 function dropTarget(node, vehicleId, beforeStopId) {
@@ -1207,9 +1254,11 @@ function moveStop(stopId, vehicleId, step, beforeStopId = null) {
     const before = beforeStopId === null ? -1 : target.indexOf(beforeStopId);
     target.splice(before < 0 ? target.length : before, 0, stopId);
     state.changed.add(vehicleId);
+    if (state.pins[stopId]) state.pins[stopId] = vehicleId;  // a pin follows its stop
   }
   state.changed.add(from);
   drawOrders();
+  drawPins();
 }
 
 function drawOrders() {
@@ -1297,6 +1346,7 @@ function drawWork() {
   if (state.jobId) showLink(state.jobId);
   else link.hidden = true;
   drawOrders();
+  drawPins();
   for (const id of ["compare-a", "compare-b"]) {
     const select = $(id);
     select.replaceChildren(...state.history.map((h, k) => el("option", { value: String(k) }, h.name)));
@@ -1494,6 +1544,7 @@ async function start() {
   $("export-geojson").addEventListener("click", exportGeojson);
   $("save").addEventListener("click", () => save().catch((error) => showError(`Unexpected: ${error.message}`)));
   $("resimulate").addEventListener("click", () => resimulate().catch((error) => showError(`Unexpected: ${error.message}`)));
+  $("replan").addEventListener("click", () => replan().catch((error) => showError(`Unexpected: ${error.message}`)));
   $("compare-a").addEventListener("change", drawCompare);
   $("compare-b").addEventListener("change", drawCompare);
   $("compare-open").addEventListener("click", () => openToCompare().catch((error) => showError(`Unexpected: ${error.message}`)));

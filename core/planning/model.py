@@ -328,6 +328,13 @@ class ShiftFields(TripFields, StartFields):
         "18:00", "Latest return to the depot, local HH:MM, after shift_start (same day)."
     )
     breaks: Breaks = breaks_field("eu-561")
+    pinned_stops: list[Annotated[str, Field(min_length=1, max_length=64)]] = Field(
+        default_factory=list,
+        max_length=MAX_STOPS,
+        description="Ids of the stops pinned to this van: no other van serves them (the search "
+        "gives each to this van or leaves it out, saying why). Empty: none; a stop pinned to no "
+        "van goes to whichever van the search finds best.",
+    )
 
     @field_validator("shift_end")
     @classmethod

@@ -7,7 +7,8 @@ A vehicle's battery falls by the energy of each arc it drives and rises at a sta
 it charges there, at a time per unit of energy; it never falls below its floor nor rises above
 its capacity. Customers are served once inside their windows (waiting allowed) within the
 load capacity. The fleet is of kinds (:class:`VehicleKind`): how many, where each sets off
-and when, by when it is back, its battery and the energy of each arc for it.
+and when, by when it is back, its battery, the energy of each arc for it and the customers it
+may not serve (pinned to others).
 
 1. **Routes of customers**: given (a planner's routes without charging), or PyVRP's routes of
    the customers alone, with windows and load, its arc times lengthened by
@@ -98,7 +99,8 @@ class VehicleKind:
     first trip may deliver (less when they set off loaded in part), and for vehicles that come
     back to reload, the place that return is (the depot's row, its service the reload's time)
     and their most trips; the time to charge one unit of energy at each place for them (their
-    charging curve; None: the instance's)."""
+    charging curve; None: the instance's); the customers they may not serve (pinned to other
+    vehicles)."""
 
     count: int
     energy: FloatArray
@@ -112,6 +114,7 @@ class VehicleKind:
     reload: int = -1
     max_trips: int = 1
     charge_time: FloatArray | None = None
+    forbidden: frozenset[int] = frozenset()
 
     def trips_carried(self, demand: FloatArray, route: Sequence[int]) -> bool:
         """Whether ``route`` (customers, :attr:`reload` between trips) keeps to the trips and
@@ -249,6 +252,15 @@ def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
     duration = np.rint(arc_time * _SCALE).astype(np.int64)
     for matrix in (distance, duration):  # staying put: an energy per arc may count a stop's
         np.fill_diagonal(matrix, 0)  # service on every arc out of it, the way back to itself too
+    horizon = float(instance.due[0])
+    durations = []  # each kind's: driving to a customer it may not serve takes past the horizon
+    for kind in instance.kinds:
+        own = duration.copy()
+        own[:, [k for k, c in enumerate(customers, start=1) if c in kind.forbidden]] = round(
+            (horizon + 1) * _SCALE
+        )
+        np.fill_diagonal(own, 0)
+        durations.append(own)
     clients = [
         pyvrp.Client(
             location=k,
@@ -259,7 +271,6 @@ def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
         )
         for k, c in enumerate(customers, start=1)
     ]
-    horizon = float(instance.due[0])
     types = [
         pyvrp.VehicleType(
             num_available=min(kind.count, len(customers)),
@@ -267,16 +278,17 @@ def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
             fixed_cost=int(distance.sum()) if instance.fewest_vehicles else 0,
             tw_early=round(kind.ready * _SCALE),
             tw_late=round(min(kind.due, horizon) * _SCALE),
+            profile=k,
         )
-        for kind in instance.kinds
+        for k, kind in enumerate(instance.kinds)
     ]
     data = pyvrp.ProblemData(
         [pyvrp.Location(0.0, 0.0) for _ in nodes],
         clients,
         [pyvrp.Depot(location=0, tw_early=0, tw_late=round(horizon * _SCALE))],
         types,
-        [distance],  # type: ignore[list-item]  # PyVRP's stubs name ndarray[int]
-        [duration],
+        [distance] * len(durations),  # type: ignore[list-item]  # PyVRP's stubs: ndarray[int]
+        durations,
     )
     stop = MultipleCriteria(
         [
@@ -349,7 +361,8 @@ class _Priced:
         self.evaluations += 1
         self.squares += seq.size**2
         load = float(self.instance.demand[seq].sum())
-        if not vehicle.trips_carried(self.instance.demand, route):
+        carried = vehicle.trips_carried(self.instance.demand, route)
+        if not carried or not vehicle.forbidden.isdisjoint(route):
             return NO_ROUTE
         cost, warp, gaps, charges, plugged = route_with_stations(
             self.facts[kind], seq, self.candidates, closed, self.penalty
@@ -385,6 +398,8 @@ class _Solution:
             c: {inst.customers[k] for k in self.nearest[n][1 : NEIGHBOURS + 1]}
             for n, c in enumerate(inst.customers)
         }
+        # a customer pinned to a few vehicles joins their routes, neighbours there or not
+        self.pinned = frozenset().union(*(kind.forbidden for kind in inst.kinds))
 
     def booked(self) -> list[Charged]:
         """The routes with their stations, the shared points booked (:meth:`_Priced.booked`;
@@ -507,10 +522,12 @@ class _Solution:
         bounds: list[tuple[float, int, int, bool]] = []
         for r, (kind, route) in enumerate(self.routes):
             vehicle = inst.kinds[kind]
+            if customer in vehicle.forbidden:
+                continue
             one_trip = vehicle.reload < 0  # else each trip's load: evaluated
             if one_trip and self.charged(kind, route).load + demand > vehicle.capacity:
                 continue
-            if not near.intersection(route):
+            if customer not in self.pinned and not near.intersection(route):
                 continue  # no neighbour of it there: it would cost more than where they are
             seq = np.array([vehicle.start, *route, 0])
             arcs = inst.distance[seq[:-1], seq[1:]]

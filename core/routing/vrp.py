@@ -3,7 +3,8 @@ budget per van, each van with its own costs.
 
 The solver sees integers only; the caller rounds explicitly: seconds for time, grams for
 payload, tenths of a watt-hour for energy, and the objective's own unit for the arc costs.
-A stop is left out only when no route can take it, never to save cost: OR-Tools pays a
+A stop pinned to some vans (:attr:`VehicleSpec.forbidden` of the others) is on one of theirs
+or left out. A stop is left out only when no route can take it, never to save cost: OR-Tools pays a
 penalty larger than any set of routes costs, PyVRP forgoes a prize larger than serving any
 stop costs.
 
@@ -95,6 +96,8 @@ class VehicleSpec:
         is under way; no stop's). It ends at the depot.
     initial_load_g
         What of ``payload_capacity_g`` its first trip cannot take [g] (it set off with less).
+    forbidden
+        Places the van may not serve (stops pinned to other vans).
     """
 
     arc_cost: IntMatrix
@@ -108,6 +111,7 @@ class VehicleSpec:
     reload_s: int = 0
     start: int = 0
     initial_load_g: int = 0
+    forbidden: frozenset[int] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -263,6 +267,7 @@ def _kind(vehicle: VehicleSpec) -> tuple[object, ...]:
         vehicle.reload_s,
         vehicle.start,
         vehicle.initial_load_g,
+        vehicle.forbidden,
     )
 
 
@@ -290,16 +295,24 @@ def _pyvrp_model(problem: RoutingInput, required: bool) -> _PyvrpModel:
     kinds: dict[tuple[object, ...], list[int]] = {}
     for v, vehicle in enumerate(problem.vehicles):
         kinds.setdefault(_kind(vehicle), []).append(v)
-    matrices: dict[int, int] = {}
+    # a profile per cost matrix and set of places a van may not serve: those are driven to
+    # past the horizon, which no route that keeps its windows does
+    travel = np.asarray(problem.travel_s, dtype=np.int64)
+    matrices: dict[tuple[int, frozenset[int]], int] = {}
     distance_matrices: list[IntMatrix] = []
+    duration_matrices: list[IntMatrix] = []
     vehicle_types = []
     depots, start_depot, reload_depot = _pyvrp_depots(problem)
     for vans in kinds.values():
         vehicle = problem.vehicles[vans[0]]
-        key = id(vehicle.arc_cost)
+        key = (id(vehicle.arc_cost), vehicle.forbidden)
         if key not in matrices:
             matrices[key] = len(distance_matrices)
             distance_matrices.append(np.rint(vehicle.arc_cost / scale).astype(np.int64))
+            duration = travel.copy()
+            duration[:, sorted(vehicle.forbidden)] = problem.horizon_s + 1
+            np.fill_diagonal(duration, np.diag(travel))
+            duration_matrices.append(duration)
         first, last = (int(t) for t in vehicle.shift_s)
         vehicle_types.append(
             pyvrp.VehicleType(
@@ -315,14 +328,13 @@ def _pyvrp_model(problem: RoutingInput, required: bool) -> _PyvrpModel:
                 initial_load=[int(vehicle.initial_load_g)],
             )
         )
-    travel = np.asarray(problem.travel_s, dtype=np.int64)
     data = pyvrp.ProblemData(
         locations,
         clients,
         depots,
         vehicle_types,
         distance_matrices,  # type: ignore[arg-type]  # PyVRP's stubs name ndarray[int]
-        [travel] * len(distance_matrices),  # type: ignore[list-item]
+        duration_matrices,  # type: ignore[arg-type]
         groups,
     )
     return _PyvrpModel(data, client_node, node_clients, list(kinds.values()))
@@ -533,7 +545,8 @@ def _kept(problem: RoutingInput, v: int, route: list[int]) -> list[int]:
             kept.append(0)
             continue
         opens = _opening(problem.windows_s[node], arrive)
-        if opens is None or load + problem.demand_g[node] > vehicle.payload_capacity_g:
+        too_heavy = load + problem.demand_g[node] > vehicle.payload_capacity_g
+        if opens is None or too_heavy or node in vehicle.forbidden:
             continue
         clock, place, load = max(arrive, opens), node, load + int(problem.demand_g[node])
         kept.append(node)
@@ -631,7 +644,7 @@ def _ortools_routes(
 
 def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapcp.RoutingModel]:
     """The routing model: each van's arc costs and fixed cost; the time, payload and energy
-    dimensions; a disjunction per stop."""
+    dimensions; a disjunction per stop, and the vans a stop pinned to some may have."""
     n = problem.travel_s.shape[0]
     starts = [v.start for v in problem.vehicles]
     manager = pywrapcp.RoutingIndexManager(n, len(problem.vehicles), starts, [0] * len(starts))
@@ -686,4 +699,8 @@ def _model(problem: RoutingInput) -> tuple[pywrapcp.RoutingIndexManager, pywrapc
         )
     for node in stops:
         routing.AddDisjunction([manager.NodeToIndex(node)], int(problem.drop_penalty))
+        allowed = [v for v, vehicle in enumerate(problem.vehicles) if node not in vehicle.forbidden]
+        if len(allowed) < len(problem.vehicles):  # -1: left out (SetAllowedVehiclesForIndex's
+            # binding takes no Python list in OR-Tools 9.15)
+            routing.VehicleVar(manager.NodeToIndex(node)).SetValues([-1, *allowed])
     return manager, routing

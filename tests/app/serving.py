@@ -83,6 +83,16 @@ def cpu_ticks(pids: list[int], window_s: float = 1.0) -> dict[int, int]:
     return used
 
 
+def wait_quiet(pid: int, timeout_s: float = 60.0, window_s: float = 0.5) -> None:
+    """Until no child of ``pid`` works (a worker started in place of a stopped one imports
+    for seconds, and would look like the one that solves)."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if all(used <= 2 for used in cpu_ticks(children(pid), window_s).values()):
+            return
+    raise AssertionError(f"the workers of {pid} still work after {timeout_s} s")
+
+
 def busiest_child(pid: int, window_s: float = 1.0) -> int | None:
     """The child of ``pid`` that used the most CPU over ``window_s`` (the worker that solves,
     however loaded the machine is), or None when none used any."""

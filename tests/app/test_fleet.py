@@ -197,6 +197,16 @@ def _with(change) -> dict:
         (lambda b: b.update(minimize_vehicles="yes"), "minimize_vehicles"),
         (lambda b: b.update(time_limit_s=0), "time_limit_s"),
         (lambda b: b.update(date="2026-02-30"), "date"),
+        (
+            lambda b: b["vehicles"][1].update(pinned_stops=["nowhere"]),
+            "vehicles[1].pinned_stops[0]",
+        ),
+        (
+            lambda b: [v.update(pinned_stops=[b["stops"][0]["id"]]) for v in b["vehicles"]],
+            "vehicles[1].pinned_stops[0]",
+        ),
+        (lambda b: b["vehicles"][0].update(pinned_stops=[""]), "vehicles[0].pinned_stops[0]"),
+        (lambda b: b["vehicles"][0].update(pinned_stops="spar-wieden"), "vehicles[0].pinned_stops"),
     ],
 )
 def test_bad_fleet_plans_name_the_field(client, change, field):
@@ -212,3 +222,18 @@ def test_a_dst_gap_shift_start_is_named(client):
     response = client.post("/v1/fleet-plans", json=body)
     assert response.status_code == 422
     assert response.json()["errors"][0]["field"] == "vehicles[0].shift_start"
+
+
+def test_stops_pinned_to_the_second_van_are_its_own(client):
+    """The example's day is one van's (van-1, listed first); two stops pinned to van-2 make it
+    drive them, and only them or more — van-1 serves neither."""
+    unpinned = client.post("/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE).json()
+    assert [r["vehicle_id"] for r in unpinned["routes"]] == ["van-1"]
+    pins = ["spar-wieden", "bio-josefstadt"]
+    body = _with(lambda b: b["vehicles"][1].update(pinned_stops=pins))
+    response = client.post("/v1/fleet-plans", json=body)
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    assert_routes_hold(answer, body)
+    by = {s["id"]: r["vehicle_id"] for r in answer["routes"] for s in r["stops"]}
+    assert [by[p] for p in pins] == ["van-2", "van-2"] and answer["unassigned"] == []

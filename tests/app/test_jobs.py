@@ -16,7 +16,14 @@ import pytest
 
 from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE, SCENARIOS_EXAMPLE
 from benchmarks.common import Server
-from tests.app.serving import alive, big_fleet, busiest_child, children, long_plan
+from tests.app.serving import (
+    alive,
+    big_fleet,
+    busiest_child,
+    children,
+    long_plan,
+    wait_quiet,
+)
 from tests.router_stub import DownRouter
 
 FAST = {
@@ -294,7 +301,8 @@ def test_cancel_a_queued_and_a_running_job(server):
 
 
 def test_a_worker_killed_mid_job_runs_it_again(server):
-    job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 4)}).json()["id"]
+    wait_quiet(server.process.pid)  # the only worker that works is then the job's
+    job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 8)}).json()["id"]
     wait_for(server.url, job_id, states=("running",))
     time.sleep(0.5)
     solving = busiest_child(server.process.pid)

@@ -590,3 +590,45 @@ def test_a_plan_saved_reopens_by_its_link_and_a_moved_stop_is_re_simulated_and_c
     ] == [[s["id"] for s in r["stops"]] for r in first["routes"]]
     shot(tab, "15-saved-reopened")
     assert outside == []
+
+
+def test_a_stop_pinned_to_another_van_is_planned_on_it(server, page, tmp_path):
+    tab, outside = page
+    tab.goto(f"{server.url}/viewer")
+    fill_day(tab, dispatch_csv(DISPATCH_ROWS), 2, tmp_path, "pins.csv")
+    tab.fill("#payload-kg", "120")  # 180 kg of deliveries: both vans drive
+    tab.get_by_test_id("plan").click()
+    expect(tab.get_by_test_id("route-line").first).to_be_visible(timeout=60_000)
+    first = tab.evaluate("window.coldroute.answer()")
+    assert len(first["routes"]) == 2, "the day needs both vans for this test"
+    source, target = (r["vehicle_id"] for r in first["routes"])
+    pinned = first["routes"][0]["stops"][0]["id"]
+    expect(tab.get_by_test_id("replan")).to_be_disabled()
+
+    # moved to the other van, then pinned there: the fleet planned again keeps it there
+    tab.locator(f"[data-testid=route][data-vehicle='{source}'] summary").click()
+    row = tab.locator(f"table[data-vehicle='{source}'] tr[data-stop='{pinned}']")
+    row.get_by_test_id("move-to").select_option(target)
+    pin = tab.locator(f"table[data-vehicle='{target}'] tr[data-stop='{pinned}']").get_by_test_id(
+        "pin"
+    )
+    pin.click()
+    expect(pin).to_have_attribute("aria-pressed", "true")
+    expect(tab.get_by_test_id("pin-status")).to_contain_text(f"{pinned} → {target}")
+    tab.get_by_test_id("replan").click()
+    expect(tab.get_by_test_id("compare")).to_contain_text("(pinned)", timeout=60_000)
+    assert tab.get_by_test_id("error").count() == 0
+    again = tab.evaluate("window.coldroute.answer()")
+    by = {s["id"]: r["vehicle_id"] for r in again["routes"] for s in r["stops"]}
+    assert by[pinned] == target
+    request = tab.evaluate("window.coldroute.request()")
+    pins = {v["id"]: v["pinned_stops"] for v in request["vehicles"]}
+    assert pins == {source: [], target: [pinned]}
+    # the new plan's table shows the pin, and unpinning it empties the list
+    tab.locator(f"[data-testid=route][data-vehicle='{target}'] summary").click()
+    shown = tab.locator(f"table[data-vehicle='{target}'] tr[data-stop='{pinned}']")
+    expect(shown.get_by_test_id("pin")).to_have_attribute("aria-pressed", "true")
+    shot(tab, "16-pinned-and-planned-again")
+    shown.get_by_test_id("pin").click()
+    expect(tab.get_by_test_id("replan")).to_be_disabled()
+    assert outside == []

@@ -232,18 +232,18 @@ def _kinds(
     reloads: tuple[dict[float, int], float],
     chargers: dict[int, ChargePoint],
 ) -> tuple[list[VehicleKind], list[list[int]]]:
-    """The fleet's kinds — vans alike in estimates, shift, start, what they carry at first
-    and their trips — and their vans; a return to reload (``reloads``: its place by the
-    reload's time) draws the van's standing loads for the reload's time; each kind charges at
-    ``chargers`` (by the search's place) along its own charging curve, on the ``reloads``'
-    margin's share of its battery. ``places``: the search's places as arcs of the day's, and
-    how many."""
+    """The fleet's kinds — vans alike in estimates, shift, start, what they carry at first,
+    their trips and the stops they may not serve — and their vans; a return to reload
+    (``reloads``: its place by the reload's time) draws the van's standing loads for the
+    reload's time; each kind charges at ``chargers`` (by the search's place) along its own
+    charging curve, on the ``reloads``' margin's share of its battery. ``places``: the
+    search's places as arcs of the day's, and how many."""
     (arcs, size), (reload_place, margin) = places, reloads
     groups: dict[tuple[object, ...], list[int]] = {}
     for v in day.vans:
         problem = day.shifts[v].problem
         trips = (problem.max_trips, problem.reload_minutes, start_payload_kg(problem))
-        key = (id(day.estimates[v]), day.shift_s[v], day.starts[v], trips)
+        key = (id(day.estimates[v]), day.shift_s[v], day.starts[v], trips, day.forbidden(v))
         groups.setdefault(key, []).append(v)
     kinds = []
     for vans in groups.values():
@@ -273,6 +273,7 @@ def _kinds(
                 reload=reload,
                 max_trips=problem.max_trips,
                 charge_time=_charge_times(battery, chargers, size),
+                forbidden=day.forbidden(v),  # the search's places of the stops are the day's
             )
         )
     return kinds, list(groups.values())

@@ -38,17 +38,19 @@ def explain(
         return Unassigned(
             id=stop_id, reason="unreachable", detail=f"no road links it with the depot '{depot}'"
         )
-    alone = [rules.alone(v, node) for v in day.vans]
+    pinned = day.pinned_to.get(node)
+    said = "" if pinned is None else f"pinned to {day.shifts[pinned].id}: "
+    alone = [rules.alone(v, node) for v in day.vans_for(node)]
     if all(why is not None for why in alone):
         refusals = [why for why in alone if why is not None]
         reason = _most_shared(Counter(why.reason for why in refusals))
         detail = next(w.detail for w in refusals if w.reason == reason)
-        return Unassigned(id=stop_id, reason=reason, detail=detail)
+        return Unassigned(id=stop_id, reason=reason, detail=said + detail)
     if failure is not None:
-        detail = f"left out after simulation: {failure.detail}"
+        detail = f"{said}left out after simulation: {failure.detail}"
         return Unassigned(id=stop_id, reason=failure.reason, detail=detail)
     reason, detail = _full(rules, node, routes)
-    return Unassigned(id=stop_id, reason=reason, detail=detail)
+    return Unassigned(id=stop_id, reason=reason, detail=said + detail)
 
 
 def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[UnassignedReason, str]:
@@ -57,13 +59,15 @@ def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[Unass
     share. A van with no route that would serve it alone has been given it (or its
     simulation said why not, :func:`core.planning.fleet.planner.search`): the vans without a route
     refuse it alone, and their reason comes first."""
-    idle = [why for v, route in enumerate(routes) if not route and (why := rules.alone(v, node))]
+    vans = rules.day.vans_for(node)
+    idle = [why for v in vans if not routes[v] and (why := rules.alone(v, node))]
     if idle:
         reason = _most_shared(Counter(why.reason for why in idle))
         detail = next(why.detail for why in idle if why.reason == reason)
         return reason, f"the vans without a route cannot serve it on a round of its own: {detail}"
     refusals: Counter[UnassignedReason] = Counter()
-    for v, route in enumerate(routes):
+    for v in vans:
+        route = routes[v]
         options = [
             rules.violations(v, [*route[:k], node, *route[k:]]) for k in range(len(route) + 1)
         ]

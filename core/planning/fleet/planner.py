@@ -225,8 +225,8 @@ def _payload_short(problem: FleetProblem, unassigned: list[Unassigned]) -> list[
 
 def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
     """Everything about a fleet plan that can be checked without solving it: unique ids of
-    stops and vans, each shift's start and end on the day in the zone, each start state
-    (its time within the shift), the client's matrix. Raises
+    stops and vans, the pinned stops' ids, each shift's start and end on the day in the zone,
+    each start state (its time within the shift), the client's matrix. Raises
     :class:`core.exceptions.CoreError` naming the field; returns each van's shift (from its
     start state's time when under way) and the zone's name."""
     check_places(problem)
@@ -242,6 +242,7 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
                 f"vehicles[{index}].id",
             )
         vans[vehicle.id] = index
+    pins = _pins(problem)
     timezone_name = ""
     shifts = []
     for index, vehicle in enumerate(problem.vehicles):
@@ -274,8 +275,32 @@ def check_fleet(problem: FleetProblem) -> tuple[list[VanShift], str]:
                 f"{vehicle.shift_end:%H:%M}",
                 f"{field}.time",
             )
-        shifts.append(VanShift(vehicle.id, under_way(round_problem), now or ends[0], ends[1]))
+        shifts.append(
+            VanShift(vehicle.id, under_way(round_problem), now or ends[0], ends[1], pins[index])
+        )
     return shifts, timezone_name
+
+
+def _pins(problem: FleetProblem) -> list[frozenset[int]]:
+    """The places of the stops pinned to each van; an unknown id, or a stop pinned twice,
+    is an error naming the second."""
+    node_of = {stop.id: node for node, stop in enumerate(problem.stops, start=1)}
+    pinned: dict[str, str] = {}
+    pins = []
+    for index, vehicle in enumerate(problem.vehicles):
+        for k, stop_id in enumerate(vehicle.pinned_stops):
+            field = f"vehicles[{index}].pinned_stops[{k}]"
+            if stop_id not in node_of:
+                raise InvalidParameterError(f"no stop has the id '{stop_id}'", field)
+            if stop_id in pinned:
+                raise InvalidParameterError(
+                    f"stop '{stop_id}' is pinned twice (also to {pinned[stop_id]}); a stop is "
+                    "pinned to one van at most",
+                    field,
+                )
+            pinned[stop_id] = f"vehicle '{vehicle.id}'"
+        pins.append(frozenset(node_of[stop_id] for stop_id in vehicle.pinned_stops))
+    return pins
 
 
 @dataclass(frozen=True)
@@ -417,11 +442,11 @@ def _given_to_idle(
             continue
         if effort.out_of_time():
             return refused, True
-        if any(_joined(day, v, node, routes, results) for v in given):
+        if any(_joined(day, v, node, routes, results) for v in given if day.may_serve(v, node)):
             refused.pop(node, None)
             continue
         tried: set[str] = set()
-        for v in day.vans:
+        for v in day.vans_for(node):
             if routes[v] or kinds[v] in tried or rules.alone(v, node) is not None:
                 continue
             tried.add(kinds[v])

@@ -48,6 +48,7 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
                 start=day.starts[v],
                 initial_load_g=payload_units_down(shift.problem.van.payload_kg)
                 - payload_units_down(start_payload_kg(shift.problem)),
+                forbidden=day.forbidden(v),
             )
         )
     never = [(day.horizon_s + 1, day.horizon_s + 1)]
@@ -59,7 +60,7 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
             node not in day.stop_nodes  # a van's position: where it sets off, not a stop
             or node in day.unreachable
             or (place and not kept)
-            or all(rules.alone(v, node) for v in day.vans)
+            or all(rules.alone(v, node) for v in day.vans_for(node))
         )
         windows.append(never if hopeless else kept)
     demand = np.where([w is never for w in windows], 0, day.demand_g)

@@ -10,6 +10,7 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,12 +37,14 @@ from core.routing.vrp import trips_of
 class VanShift:
     """One van as the search sees it: its round (van, stops, conditions), its earliest
     departure, its latest return (None: the planner's longest round) and whether its battery is
-    a constraint (a fleet's vans) or only reported (a single round)."""
+    a constraint (a fleet's vans) or only reported (a single round); the places of the stops
+    pinned to it (no other van serves them)."""
 
     id: str
     problem: PlanProblem
     start: dt.datetime
     end: dt.datetime | None
+    pinned: frozenset[int] = frozenset()
     battery_enforced: bool = True
 
 
@@ -114,6 +117,24 @@ class FleetDay:
     def stop_nodes(self) -> range:
         """The stops' places."""
         return range(1, len(self.shifts[0].problem.stops) + 1)
+
+    @cached_property
+    def pinned_to(self) -> dict[int, int]:
+        """The van each pinned stop's place is pinned to."""
+        return {node: v for v, shift in enumerate(self.shifts) for node in shift.pinned}
+
+    def may_serve(self, v: int, node: int) -> bool:
+        """Whether van ``v`` may serve the place ``node``: not pinned to another van."""
+        return self.pinned_to.get(node, v) == v
+
+    def vans_for(self, node: int) -> list[int]:
+        """The vans that may serve the place ``node``: the one it is pinned to, else all."""
+        pinned = self.pinned_to.get(node)
+        return list(self.vans) if pinned is None else [pinned]
+
+    def forbidden(self, v: int) -> frozenset[int]:
+        """The places van ``v`` may not serve: the stops pinned to other vans."""
+        return frozenset(node for node, u in self.pinned_to.items() if u != v)
 
     def order(self, v: int, route: Sequence[int]) -> list[int]:
         """The places van ``v`` drives for ``route``: from where it sets off, back to the depot."""

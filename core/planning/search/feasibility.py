@@ -58,17 +58,18 @@ class Feasibility:
         return broken
 
     def alone(self, v: int, node: int) -> Failure | None:
-        """Why van ``v`` could not serve the stop at ``node`` even on a round of its own, if it
-        could not."""
+        """Why van ``v`` (one that may serve it) could not serve the stop at ``node`` even on a
+        round of its own, if it could not."""
         day = self.day
         stop = day.shifts[v].problem.stops[node - 1]
-        payloads = [shift.problem.van.payload_kg for shift in day.shifts]
-        if stop.delivery_kg > payloads[v]:
+        vans = day.vans_for(node)
+        payloads = [day.shifts[u].problem.van.payload_kg for u in vans]
+        if stop.delivery_kg > day.shifts[v].problem.van.payload_kg:
             return Failure(
                 "capacity",
                 node,
-                f"it takes {stop.delivery_kg:g} kg; no van carries that much (largest payload "
-                f"{max(payloads):g} kg)",
+                f"it takes {stop.delivery_kg:g} kg; no van that may serve it carries that much "
+                f"(largest payload {max(payloads):g} kg)",
             )
         end_s = day.shift_s[v][1]
         window = next_window(self._reach_s(v, node), day.windows_s[node])
@@ -90,7 +91,7 @@ class Feasibility:
         budget = self.budgets_j[v]
         need_j = day.estimates[v].route_energy_j([node])
         if budget is not None and need_j > budget:
-            most_j = max(b for b in self.budgets_j if b is not None)
+            most_j = max(b for u in vans if (b := self.budgets_j[u]) is not None)
             return Failure(
                 "battery",
                 node,
@@ -115,9 +116,9 @@ class Feasibility:
         return serve + self.day.service_s[node] + self.travel_s[node, 0]
 
     def earliest(self, node: int) -> float:
-        """The earliest any van reaches ``node`` [s]."""
-        return min(self._reach_s(v, node) for v in self.day.vans)
+        """The earliest any van that may serve ``node`` reaches it [s]."""
+        return min(self._reach_s(v, node) for v in self.day.vans_for(node))
 
     def earliest_back(self, node: int) -> float:
-        """The earliest any van is back from a round to ``node`` alone [s]."""
-        return min(self._back_s(v, node) for v in self.day.vans)
+        """The earliest any van that may serve ``node`` is back from a round to it alone [s]."""
+        return min(self._back_s(v, node) for v in self.day.vans_for(node))

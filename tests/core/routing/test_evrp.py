@@ -328,3 +328,23 @@ def test_the_benchmark_command_answers_one_checked_json_line_per_instance():
         timeout=60,
     )
     assert bad.returncode == 2 and "--time-limit" in bad.stderr
+
+
+@pytest.mark.parametrize("pinned", [1, 3, 5])
+def test_a_customer_pinned_to_a_kind_is_served_by_it_and_the_rest_by_the_others(pinned):
+    """The small instance with one more vehicle of a second kind, alike but the only one
+    that may serve ``pinned`` (the first kind forbids it): every customer served, ``pinned``
+    on the second kind's route, no route of the first kind holding it — and pricing a route
+    of the first kind through it is no route."""
+    inst = small()
+    base = inst.kinds[0]
+    kinds = [replace(base, forbidden=frozenset({pinned})), replace(base, count=1)]
+    with_pin = replace(inst, kinds=kinds)
+    solution = solve_evrptw(with_pin, Effort.starting_now(1.0, 60.0))
+    assert solution.left_out == []
+    holding = [route.kind for route in solution.routes if pinned in [v.place for v in route.visits]]
+    assert holding == [1]
+    routes = [[(v.place, v.charge) for v in route.visits] for route in solution.routes]
+    assert check(with_pin, routes) is None
+    priced = _Priced(with_pin)
+    assert priced.charged(0, [pinned]) is NO_ROUTE and priced.charged(1, [pinned]) is not NO_ROUTE

@@ -3,7 +3,10 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
+import pytest
 
 from core.routing.effort import Effort
 from core.routing.units import (
@@ -12,7 +15,14 @@ from core.routing.units import (
     payload_units_down,
     payload_units_up,
 )
-from core.routing.vrp import RoutingInput, VehicleSpec, solve_routes
+from core.routing.vrp import (
+    RoutingInput,
+    VehicleSpec,
+    _kept,
+    _ortools_routes,
+    _pyvrp_routes,
+    solve_routes,
+)
 
 #: A second of search work, the deadline far enough not to stop it.
 WORK = Effort(1.0, float("inf"))
@@ -151,3 +161,26 @@ def test_pyvrp_is_given_costs_in_the_root_of_what_a_second_of_driving_costs():
     fixed = _pyvrp_model(problem(positions, vans=3, fixed=10**6), required=True)
     np.testing.assert_array_equal(np.asarray(fixed.data.distance_matrix(0)), line(positions) * 1000)
     assert fixed.data.vehicle_type(0).fixed_cost > 4_000 * 4 * 3
+
+
+@pytest.mark.parametrize("engine", ["pyvrp", "ortools"])
+def test_each_engine_serves_a_pinned_stop_only_by_its_van(engine):
+    # Two vans, stops at 1 and 5 km; one van could serve all for 10 km and a second costs a
+    # fixed 10**6. Stop 1 pinned to van 1 (forbidden for van 0): van 1 serves all, van 0 none.
+    base = problem([1, 1, 5, 5], vans=2, fixed=10**6)
+    vehicles = [replace(base.vehicles[0], forbidden=frozenset({1})), base.vehicles[1]]
+    pinned = replace(base, vehicles=vehicles)
+    if engine == "pyvrp":
+        routes, _ = _pyvrp_routes(pinned, WORK, None)
+    else:
+        outcome = _ortools_routes(pinned, WORK, None)
+        assert outcome is not None
+        routes = outcome.routes
+    assert routes is not None and routes[0] == [] and sorted(routes[1]) == [1, 2, 3, 4]
+    assert cost(routes, [1, 1, 5, 5]) == 10
+
+
+def test_a_route_cut_from_an_infeasible_search_drops_a_stop_pinned_elsewhere():
+    base = problem([1, 2, 3])
+    pinned = replace(base, vehicles=[replace(base.vehicles[0], forbidden=frozenset({2}))])
+    assert _kept(pinned, 0, [1, 2, 3]) == [1, 3]
