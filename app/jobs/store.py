@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
-from sqlalchemy import ColumnElement, delete, select, text, update
+from sqlalchemy import ColumnElement, case, delete, select, text, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
@@ -358,12 +358,14 @@ def _due(moment: dt.datetime) -> ColumnElement[bool]:
 
 
 def _running(runner: str, moment: dt.datetime) -> dict[str, Any]:
-    """The values of a job that ``runner`` takes at ``moment``."""
+    """The values of a job that ``runner`` takes at ``moment`` — never started before it was
+    created: a job stored after ``moment`` was read, and before the update, is taken too."""
+    started = case((Job.created_at > moment, Job.created_at), else_=moment)
     return {
         "status": "running",
         "runner": runner,
-        "started_at": moment,
-        "heartbeat_at": moment,
+        "started_at": started,
+        "heartbeat_at": started,
         "run_after": None,
         "attempts": Job.attempts + 1,
     }
