@@ -37,6 +37,7 @@ ERRORS: dict[str, tuple[int, ...]] = {
     "simulateTrace": (401, 413, 422, 503),
     "sweepSpeeds": (401, 413, 422, 503),
     "runScenarios": (401, 413, 422, 503),
+    "studyElectrification": (401, 413, 422, 503),
     "createCalibration": (401, 413, 422, 503),
     "createCalibrationFromCsv": (401, 413, 422, 503),
     "listPresets": (401,),
@@ -57,6 +58,7 @@ EXAMPLES = {
     "simulateTrace": "simulate",
     "sweepSpeeds": "speed_sweep",
     "runScenarios": "scenarios",
+    "studyElectrification": "electrification",
     "getJob": "job",
     "createCalibration": "calibration",
 }

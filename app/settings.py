@@ -77,6 +77,18 @@ class Settings(BaseSettings):
         description="Most time a study submitted as a job may simulate [s] (about ten years "
         "of driving).",
     )
+    max_route_days: int = Field(
+        200_000,
+        ge=1,
+        description="Most route-days × candidates one electrification study simulates (50 "
+        "routes × 365 days × 3 candidates is 54,750 × 3); beyond, a 413 names the limit.",
+    )
+    max_sync_route_days: int = Field(
+        1_000,
+        ge=1,
+        description="Most route-days × candidates a synchronous electrification study "
+        "simulates (a few seconds of work); beyond, a 413 points to jobs.",
+    )
     max_sync_calibration_samples: int = Field(
         100_000,
         ge=2,

@@ -11,11 +11,13 @@ from typing import Any, Generic, TypeVar
 
 from pydantic import BaseModel
 
-from app.operations import calibration, fleet_plan, plan, studies
+from app.operations import calibration, electrification, fleet_plan, plan, studies
 from app.schemas.calibration import CalibrationRequest, CalibrationResponse
 from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
 from app.schemas.plans import PlanRequest, PlanResponse
 from app.schemas.studies import (
+    ElectrificationRequest,
+    ElectrificationResponse,
     ScenariosRequest,
     ScenariosResponse,
     SpeedSweepRequest,
@@ -93,6 +95,15 @@ JOB_KINDS: dict[str, JobKind[Any, Any]] = {
         studies.sweep_speeds,
         lambda _request, response: response,
         lambda _request: 0.0,  # no solver: the sweep's simulations alone
+    ),
+    "electrification": JobKind(
+        ElectrificationRequest,
+        ElectrificationResponse,
+        "of /v1/studies/electrification",
+        electrification.check_electrification,
+        electrification.run_electrification_job,
+        lambda _request, response: response,
+        lambda _request: 0.0,  # no solver: the routes' simulations alone
     ),
     "calibration": JobKind(
         CalibrationRequest,

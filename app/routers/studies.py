@@ -7,10 +7,13 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 
 from app.deps import ExecutorDep, SettingsDep
-from app.examples import SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
+from app.examples import ELECTRIFICATION_EXAMPLE, SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
+from app.operations.electrification import run_electrification as electrification
 from app.operations.studies import run_scenarios as scenarios
 from app.operations.studies import sweep_speeds as sweep
 from app.schemas.studies import (
+    ElectrificationRequest,
+    ElectrificationResponse,
     ScenariosRequest,
     ScenariosResponse,
     SpeedSweepRequest,
@@ -62,3 +65,32 @@ async def run_scenarios(
     """The round planned once for its own conditions (the baseline), then simulated on that
     tour for every combination of season, driver aggressiveness and traffic density."""
     return await pool.run(scenarios, request, settings, disconnected=http.is_disconnected)
+
+
+@router.post(
+    "/electrification",
+    operation_id="studyElectrification",
+    summary="Which routes can go electric, with which battery",
+)
+async def study_electrification(
+    request: Annotated[
+        ElectrificationRequest,
+        Body(
+            openapi_examples={
+                "vienna-two-routes": {
+                    "summary": "Two Vienna routes on weekdays, three batteries",
+                    "value": ELECTRIFICATION_EXAMPLE,
+                }
+            }
+        ),
+    ],
+    http: Request,
+    settings: SettingsDep,
+    pool: ExecutorDep,
+) -> ElectrificationResponse:
+    """Each route as it was driven — its stops in order from its start time — simulated for
+    each candidate van on every day it is driven in the year, with that date's weather: the
+    days each battery covers (alone, and with the charges a day may take), the battery that
+    covers 95 % and all of them, the worst days and why; per candidate, the routes that go
+    electric and the depot's recharge. Larger studies run as jobs (type electrification)."""
+    return await pool.run(electrification, request, settings, disconnected=http.is_disconnected)

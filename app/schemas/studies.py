@@ -2,13 +2,28 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import Field
 
 from app.schemas.base import ApiModel, ConsumptionWhPerKm, EnergyKwh, VanRequest
 from app.schemas.plans import PlanRequest
-from core.params import ClockTime, IsoDate, Location, TrafficDensity, Weather, clock_field
+from core.params import (
+    ClockTime,
+    IsoDate,
+    Location,
+    RefrigerationStrategy,
+    TrafficDensity,
+    Weather,
+    clock_field,
+)
+from core.planning.electrification.model import (
+    MAX_CANDIDATES,
+    MAX_ROUTES,
+    ChargeOption,
+    DrivenRoute,
+    ElectrificationResult,
+)
 from core.planning.studies import ScenarioCell, Season, SpeedPoint
 
 
@@ -104,3 +119,57 @@ class ScenariosResponse(ApiModel):
     cells: list[ScenarioCellOut] = Field(
         ..., description="One row per season × driver × traffic combination."
     )
+
+
+class CandidateRequest(VanRequest):
+    """A van the routes might be driven with, as in a plan: a preset or profile and the
+    parameters to change (its battery, its box, its refrigeration strategy)."""
+
+    id: str = Field(..., min_length=1, max_length=64, description="The candidate's id, unique.")
+
+
+class StudyWeather(ApiModel):
+    """Where each date's weather comes from."""
+
+    source: Literal["climatology"] = Field(
+        "climatology",
+        description="climatology: the typical day of each date at the place (the depot's, or "
+        "location).",
+    )
+
+
+class ElectrificationRequest(ApiModel):
+    """The fleet's routes as driven over a year, and the vans they might be driven with."""
+
+    year: int = Field(..., ge=1901, le=2199, description="The year studied.")
+    timezone: str | None = Field(
+        None, max_length=64, description="IANA zone of the routes' clocks; absent: solar time."
+    )
+    location: Location | None = Field(
+        None, description="The place whose climate each date's weather is; absent: each depot's."
+    )
+    routes: list[DrivenRoute] = Field(
+        ..., min_length=1, max_length=MAX_ROUTES, description="The routes, as driven."
+    )
+    candidates: list[CandidateRequest] = Field(
+        ..., min_length=1, max_length=MAX_CANDIDATES, description="The vans to try."
+    )
+    chargers: list[ChargeOption] = Field(
+        default_factory=list,
+        max_length=10,
+        description="The charges a day may take, together (at the depot at lunch, on the way); "
+        "empty: a day is covered on one charge alone.",
+    )
+    refrigeration: RefrigerationStrategy | None = Field(
+        None,
+        description="The refrigeration unit's strategy for each candidate that does not say "
+        "its own; absent: each candidate's (the thermostat by default).",
+    )
+    weather: StudyWeather = Field(
+        default_factory=StudyWeather, description="Where each date's weather comes from."
+    )
+
+
+class ElectrificationResponse(ApiModel, ElectrificationResult):
+    """Per route and candidate, the days covered and the battery that covers them; per
+    candidate, the fleet."""

@@ -38,12 +38,15 @@ def test_every_phase_and_check_passes():
             "COLDROUTE_MAX_JOB_TIME_LIMIT_S": "0.05",
             "COLDROUTE_MAX_BODY_BYTES": "200000",
             "COLDROUTE_MAX_STUDY_CELL_STOPS": "100",
+            "COLDROUTE_MAX_SYNC_ROUTE_DAYS": "20",
+            "COLDROUTE_MAX_ROUTE_DAYS": "100",
         }
     ).start()
     try:
         run = _schemathesis(server)
         if run.returncode and CPYTHON_AST_BUG in run.stdout + run.stderr:
-            run = _schemathesis(server)  # the tool's own failure (above): once more
+            # the tool's own failure (below): once more, with one worker (no thread races)
+            run = _schemathesis(server, workers=1)
         log = server.log_path.read_text()
     finally:
         server.close()
@@ -51,11 +54,12 @@ def test_every_phase_and_check_passes():
 
 
 #: How CPython 3.11's AST depth counter (gh-106905) fails inside Schemathesis: seen once in
-#: several full runs with two Schemathesis workers, never in the service's answers.
+#: several full runs with two Schemathesis workers (twice in a row on a busy machine), never in
+#: the service's answers; it races between threads, so one worker does not meet it.
 CPYTHON_AST_BUG = "AST constructor recursion depth mismatch"
 
 
-def _schemathesis(server: Server) -> subprocess.CompletedProcess[str]:
+def _schemathesis(server: Server, workers: int = 2) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [
             *SCHEMATHESIS,
@@ -77,7 +81,7 @@ def _schemathesis(server: Server) -> subprocess.CompletedProcess[str]:
             "--request-timeout",
             "60",
             "--workers",
-            "2",
+            str(workers),
             "--no-color",
         ],
         cwd=ROOT,  # schemathesis.toml

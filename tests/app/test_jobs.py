@@ -14,7 +14,12 @@ from pathlib import Path
 import httpx
 import pytest
 
-from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE, SCENARIOS_EXAMPLE
+from app.examples import (
+    ELECTRIFICATION_EXAMPLE,
+    FLEET_PLAN_EXAMPLE,
+    PLAN_EXAMPLE,
+    SCENARIOS_EXAMPLE,
+)
 from benchmarks.common import Server
 from tests.app.serving import (
     alive,
@@ -351,3 +356,19 @@ def test_finished_jobs_expire_after_the_retention():
             time.sleep(0.5)
     finally:
         short.close()
+
+
+def test_an_electrification_job_answers_what_the_endpoint_answers(server):
+    """The study as a job in the worker pool: the same routes, days and verdicts as the
+    synchronous answer (its clock aside)."""
+    sync = httpx.post(
+        f"{server.url}/v1/studies/electrification", json=ELECTRIFICATION_EXAMPLE, timeout=120
+    )
+    assert sync.status_code == 200, sync.text
+    job_id = submit(server.url, {"type": "electrification", "request": ELECTRIFICATION_EXAMPLE})
+    done = wait_for(server.url, job_id.json()["id"], timeout=120)
+    assert done["status"] == "succeeded", done
+    timing = ("runtime_s", "route_days_per_s")
+    assert {k: v for k, v in done["result"].items() if k not in timing} == {
+        k: v for k, v in sync.json().items() if k not in timing
+    }

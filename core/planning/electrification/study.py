@@ -1,0 +1,240 @@
+"""The routes' days simulated: each route laid out once per candidate — its drives, its stops
+and door openings, its breaks, the same on every day it is driven — and simulated on each of
+its days with the sun and the temperatures of that date (:func:`core.physics.simulate.simulate`;
+a date's weather is the climatology of the depot's place, :mod:`core.physics.weather`).
+
+A day is covered when the battery keeps its reserve all day
+(:class:`core.physics.battery.BatteryVerdict`: from the state of charge never clipped); with a
+top-up allowed, also when the charge it lacks fits in the top-up (:func:`topped_up`). Telematics
+"EV suitability" assessments (Geotab's EVSA) leave the refrigeration unit out; here it is in,
+with every door opening, and the cold chain's verdict of each day.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import time
+from collections.abc import Callable, Sequence
+
+from core.clock import departure
+from core.exceptions import CoreError, InvalidParameterError
+from core.params import Location, VanParams, product_band
+from core.physics.battery import BatteryVerdict
+from core.physics.cold_chain import check_cold_chain
+from core.physics.simulate import CONSUMERS, SimulationResult, simulate
+from core.planning.day.scene import legs_for, round_places
+from core.planning.day.timeline import PLAN_DT_S, Timeline, build_timeline, rest_after
+from core.planning.electrification.model import (
+    WEEKDAYS,
+    ChargeOption,
+    DrivenRoute,
+    ElectrificationProblem,
+    ElectrificationResult,
+    Weekdays,
+)
+from core.planning.electrification.summary import DayOutcome, fleet_outcome, route_outcome
+from core.planning.itinerary import Itinerary
+from core.planning.model import PlanProblem
+from core.planning.round.planner import check
+from core.planning.search.day import leg_roads
+from core.routing.roads import RoadRouter
+
+
+def route_dates(route: DrivenRoute, year: int, field: str) -> list[dt.date]:
+    """The dates ``route`` is driven in ``year``; a date of another year names its field."""
+    if isinstance(route.days, Weekdays):
+        wanted = {WEEKDAYS.index(day) for day in route.days.weekdays}
+        every = (dt.date(year, 1, 1) + dt.timedelta(days=k) for k in range(366))
+        return [d for d in every if d.year == year and d.weekday() in wanted]
+    for k, date in enumerate(route.days):
+        if date.year != year:
+            raise InvalidParameterError(
+                f"{date} is not in the study's year {year}", f"{field}[{k}]"
+            )
+    return list(route.days)
+
+
+def route_days(problem: ElectrificationProblem) -> int:
+    """How many route-days the study simulates (each for every candidate)."""
+    return sum(
+        len(route_dates(r, problem.year, f"routes[{i}].days")) for i, r in enumerate(problem.routes)
+    )
+
+
+def check_study(problem: ElectrificationProblem) -> None:
+    """Everything that can be checked before simulating: unique ids, the dates in the year,
+    each route a round every candidate can drive (its stops' ids, its payload, its start time
+    on its first day). Raises :class:`core.exceptions.CoreError` naming the field."""
+    ids = {
+        "routes": [r.id for r in problem.routes],
+        "candidates": [c.id for c in problem.candidates],
+    }
+    for name, listed in ids.items():
+        seen: dict[str, int] = {}
+        for k, item_id in enumerate(listed):
+            if item_id in seen:
+                raise InvalidParameterError(
+                    f"id '{item_id}' is used twice (also by {name}[{seen[item_id]}]); ids must "
+                    "be unique",
+                    f"{name}[{k}].id",
+                )
+            seen[item_id] = k
+    for i, route in enumerate(problem.routes):
+        dates = route_dates(route, problem.year, f"routes[{i}].days")
+        if not dates:
+            raise InvalidParameterError("no day of the year is driven", f"routes[{i}].days")
+        for candidate in problem.candidates:
+            try:
+                check(_round(problem, route, candidate.van, dates[0]))
+            except CoreError as error:
+                if error.field == "timezone":  # the study's own
+                    raise
+                said = f"with candidate '{candidate.id}': {error.message}"
+                raise type(error)(said, error.field).under(f"routes[{i}]") from None
+
+
+def study(
+    problem: ElectrificationProblem,
+    router: RoadRouter | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> ElectrificationResult:
+    """Simulate every route on each of its days for each candidate and sum it up per route
+    and per candidate (:mod:`core.planning.electrification.summary`). ``progress`` is told
+    the route-days done after each route."""
+    started = time.perf_counter()
+    check_study(problem)
+    outcomes = []
+    years: list[dict[str, list[DayOutcome]]] = []
+    for i, route in enumerate(problem.routes):
+        dates = route_dates(route, problem.year, f"routes[{i}].days")
+        try:
+            year = {
+                c.id: route_year(problem, route, c.van, dates, router) for c in problem.candidates
+            }
+        except CoreError as error:
+            raise error.under(f"routes[{i}]") from None
+        years.append(year)
+        outcomes.append(route_outcome(route.id, year, problem.chargers))
+        if progress is not None:
+            progress(len(dates))
+    runtime_s = time.perf_counter() - started
+    count = sum(len(next(iter(year.values()))) for year in years)
+    return ElectrificationResult(
+        routes=outcomes,
+        fleet=[
+            fleet_outcome(c.id, outcomes, [year[c.id] for year in years], problem.chargers)
+            for c in problem.candidates
+        ],
+        route_days=count,
+        route_days_per_s=count * len(problem.candidates) / max(runtime_s, 1e-9),
+        runtime_s=runtime_s,
+        weather_source="climatology",
+    )
+
+
+def carrying(van: VanParams, route: DrivenRoute) -> VanParams:
+    """``van`` with the route's goods in its box (:attr:`DrivenRoute.product`)."""
+    if route.product is None:
+        return van
+    box, band = van.cargo_box, product_band(route.product)
+    inside = band.min_c <= box.setpoint_c <= band.max_c
+    changes = {"product": route.product, "setpoint_c": box.setpoint_c if inside else band.middle_c}
+    # the set-point is inside the band: the box's checks hold as they did
+    carried = type(box).model_validate(box.model_dump() | changes)
+    return van.model_copy(update={"cargo_box": carried})
+
+
+def _round(
+    problem: ElectrificationProblem, route: DrivenRoute, van: VanParams, date: dt.date
+) -> PlanProblem:
+    """The route on ``date`` as a round driven in its order by ``van`` (with its goods)."""
+    return PlanProblem(
+        date=date,
+        timezone=problem.timezone,
+        depot=route.depot,
+        stops=route.stops,
+        start_time=route.start_time,
+        keep_order=True,
+        van=carrying(van, route),
+    )
+
+
+def route_year(
+    problem: ElectrificationProblem,
+    route: DrivenRoute,
+    van: VanParams,
+    dates: Sequence[dt.date],
+    router: RoadRouter | None = None,
+) -> list[DayOutcome]:
+    """The route laid out once for ``van`` and simulated on each of ``dates``."""
+    first = _round(problem, route, van, dates[0])
+    van = first.van
+    timeline = _laid_out(first, router)
+    location = problem.location or Location(lat=route.depot.lat, lon=route.depot.lon)
+    out = []
+    for date in dates:
+        start, _ = departure(date, route.start_time, problem.timezone, route.depot.lon)
+        result = simulate(
+            timeline.speed,
+            PLAN_DT_S,
+            start,
+            location,
+            van,
+            grade=timeline.grade,
+            payload_kg=timeline.payload,
+            door_openings=timeline.doors,
+            parked=timeline.parked,
+            heading_deg=timeline.heading,
+        )
+        out.append(_day(date, van, result, problem.chargers))
+    return out
+
+
+def _laid_out(problem: PlanProblem, router: RoadRouter | None) -> Timeline:
+    """The route's day: its drives (the router's roads when it has them), stops, door
+    openings and breaks, in the order given, from its departure."""
+    start, _ = check(problem)
+    places = round_places(problem)
+    legs = legs_for(problem, router, places)
+    order = [*range(len(places)), 0]
+    roads = leg_roads(router, places, order) if router and legs.source == "osrm" else None
+    rest = rest_after(problem, start)
+    return build_timeline(problem, places, legs, Itinerary.of(order), roads, None, rest)
+
+
+def _day(
+    date: dt.date, van: VanParams, result: SimulationResult, chargers: Sequence[ChargeOption]
+) -> DayOutcome:
+    band, product_c = van.cargo_box.band, result.box.product_c
+    holds = band is None or product_c is None or check_cold_chain(band, product_c, PLAN_DT_S).holds
+    return DayOutcome(
+        date=date,
+        energy_kwh={
+            **{name: result.energy_kwh[name] for name in CONSUMERS},
+            "battery_loss": result.battery_loss_kwh,
+            "total": result.energy_kwh["total"] + result.battery_loss_kwh,
+        },
+        battery=result.battery,
+        cold_chain_holds=holds,
+        t_min_c=float(result.ambient_c.min()),
+        t_max_c=float(result.ambient_c.max()),
+        distance_m=result.distance_m,
+        duration_s=result.duration_s,
+        covered_with_top_up=topped_up(result.battery, van, chargers),
+    )
+
+
+def topped_up(battery: BatteryVerdict, van: VanParams, chargers: Sequence[ChargeOption]) -> bool:
+    """Whether a day with this ``battery`` verdict is covered with ``chargers``: it keeps its
+    reserve on one charge, or the charge it lacks (``-margin_kwh``) is stored within the
+    charges' minutes at their power, capped by the van's, at the van's charging efficiency."""
+    if battery.feasible:
+        return True
+    stored_kwh = sum(
+        min(c.power_kw, van.battery.max_charge_power_kw)
+        * van.battery.charging_efficiency
+        * c.minutes
+        / 60.0
+        for c in chargers
+    )
+    return bool(chargers) and -battery.margin_kwh <= stored_kwh

@@ -1,0 +1,168 @@
+"""The simulated days summed up: per route and candidate, the days covered, the battery that
+covers 95 % and all of them, the worst days and what made them worst; per candidate, the fleet
+(how many routes go electric, what the depot must recharge)."""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.physics.battery import BatteryVerdict
+from core.planning.electrification.model import (
+    CandidateOutcome,
+    ChargeOption,
+    FleetOutcome,
+    Reason,
+    RouteOutcome,
+    WorstDay,
+)
+
+#: Worst days listed per route and candidate.
+WORST_DAYS = 5
+#: Share of the days the battery of ``required_kwh_p95`` covers.
+COVERED_SHARE = 0.95
+#: Consumers whose energy changes with the weather (the battery's loss in the cold or heat too).
+THERMAL = ("cabin", "refrigeration", "battery_loss")
+#: Least time a van is parked at the depot between two days, for its recharge's power [h].
+MIN_PARKED_H = 1.0
+
+
+@dataclass(frozen=True)
+class DayOutcome:
+    """One route-day of one candidate: energy per consumer (``battery_loss``, ``total``)
+    [kWh], the battery's verdict, the cold chain's, the day's coldest and warmest moments
+    [°C], its distance [m] and duration [s], and whether a top-up covers it."""
+
+    date: dt.date
+    energy_kwh: dict[str, float]
+    battery: BatteryVerdict
+    cold_chain_holds: bool
+    t_min_c: float
+    t_max_c: float
+    distance_m: float
+    duration_s: float
+    covered_with_top_up: bool
+
+
+def route_outcome(
+    route_id: str, year: dict[str, list[DayOutcome]], chargers: Sequence[ChargeOption]
+) -> RouteOutcome:
+    """One route: each candidate's ``year`` of days (by candidate id) summed up."""
+    first = next(iter(year.values()))[0]
+    return RouteOutcome(
+        id=route_id,
+        distance_km=first.distance_m / 1000.0,
+        candidates=[candidate_outcome(cid, days, chargers) for cid, days in year.items()],
+    )
+
+
+def candidate_outcome(
+    candidate_id: str, days: Sequence[DayOutcome], chargers: Sequence[ChargeOption]
+) -> CandidateOutcome:
+    """One candidate's days on one route summed up."""
+    required = np.array([d.battery.required_capacity_kwh for d in days])
+    feasible = sum(d.battery.feasible for d in days)
+    topped = None if not chargers else sum(d.covered_with_top_up for d in days)
+    return CandidateOutcome(
+        id=candidate_id,
+        days_total=len(days),
+        days_feasible=feasible,
+        share_feasible=feasible / len(days),
+        days_feasible_with_charging=topped,
+        share_feasible_with_charging=None if topped is None else topped / len(days),
+        # the smallest capacity that at least this share of the days needs no more than
+        required_kwh_p95=float(np.quantile(required, COVERED_SHARE, method="inverted_cdf")),
+        required_kwh_max=float(required.max()),
+        lacking_kwh_max=max(max(-d.battery.margin_kwh, 0.0) for d in days),
+        energy_kwh_mean={
+            k: float(np.mean([d.energy_kwh[k] for d in days])) for k in days[0].energy_kwh
+        },
+        cold_chain_days_broken=sum(not d.cold_chain_holds for d in days),
+        worst_days=worst_days(days),
+    )
+
+
+def _whole(value: float) -> str:
+    """``value`` to the unit, never "-0"."""
+    return f"{round(value) + 0:d}"
+
+
+def _thermal_kwh(day: DayOutcome) -> float:
+    return sum(day.energy_kwh[name] for name in THERMAL)
+
+
+def _mean_c(day: DayOutcome) -> float:
+    return (day.t_min_c + day.t_max_c) / 2.0
+
+
+def worst_days(days: Sequence[DayOutcome]) -> list[WorstDay]:
+    """The :data:`WORST_DAYS` days the battery ran lowest, lowest first, each with its reason:
+    distance when even the route's best day falls below the reserve; else heat or cold, as the
+    day is warmer or colder than the route's median day (its weather-driven energy — cab,
+    refrigeration, the battery's temperature loss — set beside the median day's)."""
+    best = max(days, key=lambda d: d.battery.min_soc)
+    median_kwh = float(np.median([_thermal_kwh(d) for d in days]))
+    median_c = float(np.median([_mean_c(d) for d in days]))
+    out = []
+    for day in sorted(days, key=lambda d: (d.battery.min_soc, d.date))[:WORST_DAYS]:
+        reason: Reason = (
+            "distance"
+            if not best.battery.feasible
+            else ("heat" if _mean_c(day) >= median_c else "cold")
+        )
+        energy = day.energy_kwh
+        detail = (
+            f"{_whole(day.t_min_c)} to {_whole(day.t_max_c)} °C: cab {energy['cabin']:.1f} kWh, "
+            f"refrigeration {energy['refrigeration']:.1f} kWh, battery loss "
+            f"{energy['battery_loss']:.1f} kWh ({_thermal_kwh(day) - median_kwh:+.1f} kWh over "
+            f"the route's median day); {energy['total']:.1f} kWh in all, lowest charge "
+            f"{day.battery.min_soc:.0%}"
+        )
+        out.append(
+            WorstDay(
+                date=day.date,
+                reason=reason,
+                min_soc=day.battery.min_soc,
+                required_kwh=day.battery.required_capacity_kwh,
+                t_min_c=day.t_min_c,
+                t_max_c=day.t_max_c,
+                detail=detail,
+            )
+        )
+    return out
+
+
+def fleet_outcome(
+    candidate_id: str,
+    routes: Sequence[RouteOutcome],
+    years: Sequence[Sequence[DayOutcome]],
+    chargers: Sequence[ChargeOption],
+) -> FleetOutcome:
+    """One candidate across the fleet: ``routes`` summed up, and ``years`` (its days on each
+    route) for the depot's recharge on each date — each van back to full from the grid
+    (:attr:`BatteryVerdict.recharge_kwh`), evenly while parked until the same time the next
+    day; the days it covers on one charge (it drives no other electric)."""
+    mine = [next(c for c in r.candidates if c.id == candidate_id) for r in routes]
+    energy: dict[dt.date, float] = defaultdict(float)
+    power: dict[dt.date, float] = defaultdict(float)
+    for days in years:
+        for day in days:
+            if not day.battery.feasible:  # a day the van cannot drive is not driven electric
+                continue
+            parked_h = max((86_400.0 - day.duration_s) / 3600.0, MIN_PARKED_H)
+            energy[day.date] += day.battery.recharge_kwh
+            power[day.date] += day.battery.recharge_kwh / parked_h
+    return FleetOutcome(
+        id=candidate_id,
+        routes_all_year=sum(c.days_feasible == c.days_total for c in mine),
+        routes_p95=sum(c.share_feasible >= COVERED_SHARE for c in mine),
+        routes_all_year_with_charging=None
+        if not chargers
+        else sum(c.days_feasible_with_charging == c.days_total for c in mine),
+        depot_kwh_max_day=max(energy.values(), default=0.0),
+        depot_kw_peak=max(power.values(), default=0.0),
+    )

@@ -1,0 +1,131 @@
+"""POST /v1/studies/electrification as a fleet manager calls it: the example's routes over a
+year, every verdict agreeing with the answer's own numbers, the limits (a 413 naming the
+limit, a synchronous one pointing to jobs) and bad input named by its field."""
+
+from __future__ import annotations
+
+import copy
+import datetime as dt
+
+import pytest
+
+from app.examples import ELECTRIFICATION_EXAMPLE
+from tests.app.apps import app_client
+
+PATH = "/v1/studies/electrification"
+
+
+@pytest.fixture(scope="module")
+def answer():
+    response = app_client().post(PATH, json=ELECTRIFICATION_EXAMPLE)
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def test_the_example_covers_each_route_with_the_battery_its_days_need(answer):
+    """Mondays, Wednesdays, Fridays of 2026 are 156 days, Tuesdays and Thursdays 105; each
+    candidate covers a route on the days whose need its battery holds."""
+    routes = {r["id"]: r for r in answer["routes"]}
+    assert [c["days_total"] for c in routes["inner-city"]["candidates"]] == [156, 156]
+    assert [c["days_total"] for c in routes["long-day"]["candidates"]] == [105, 105]
+    assert answer["route_days"] == 261 and answer["weather_source"] == "climatology"
+    for route in answer["routes"]:
+        for outcome in route["candidates"]:
+            capacity = int(outcome["id"].split("-")[1])  # reefer-40, reefer-70
+            all_year = outcome["days_feasible"] == outcome["days_total"]
+            assert all_year == (outcome["required_kwh_max"] <= capacity)
+            assert outcome["share_feasible"] == outcome["days_feasible"] / outcome["days_total"]
+            assert outcome["required_kwh_p95"] <= outcome["required_kwh_max"]
+            assert outcome["days_feasible"] <= outcome["days_feasible_with_charging"]
+            assert (outcome["lacking_kwh_max"] == 0) == all_year
+            worst = outcome["worst_days"]
+            assert len(worst) == 5 and worst == sorted(worst, key=lambda w: w["min_soc"])
+            assert all(dt.date.fromisoformat(w["date"]).year == 2026 for w in worst)
+    # the long day needs more than 40 kWh every day (the lunch charge covers it) and less
+    # than 70: the 70 kWh van drives both routes all year
+    fleet = {f["id"]: f for f in answer["fleet"]}
+    assert fleet["reefer-40"]["routes_all_year"] == 1
+    assert fleet["reefer-40"]["routes_all_year_with_charging"] == 2
+    assert fleet["reefer-70"]["routes_all_year"] == 2
+    long_40 = routes["long-day"]["candidates"][0]
+    assert long_40["days_feasible"] == 0 and long_40["worst_days"][0]["reason"] == "distance"
+    # winter is the worst for these routes: cab heating and the battery's cold
+    assert routes["long-day"]["candidates"][1]["worst_days"][0]["reason"] == "cold"
+    # the depot recharges only the days driven on one charge: more with the larger battery
+    assert fleet["reefer-70"]["depot_kwh_max_day"] > fleet["reefer-40"]["depot_kwh_max_day"]
+
+
+def test_the_same_request_gives_the_same_answer(answer):
+    again = app_client().post(PATH, json=ELECTRIFICATION_EXAMPLE).json()
+    timing = ("runtime_s", "route_days_per_s")
+    assert {k: v for k, v in again.items() if k not in timing} == {
+        k: v for k, v in answer.items() if k not in timing
+    }
+
+
+def test_a_candidate_without_its_own_strategy_takes_the_studys():
+    body = copy.deepcopy(ELECTRIFICATION_EXAMPLE)
+    body["routes"] = body["routes"][:1]
+    body["routes"][0]["days"] = ["2026-07-15"]
+    body["candidates"] = body["candidates"][:1]
+    thermostat = app_client().post(PATH, json=body).json()
+    body["refrigeration"] = {"strategy": "optimal"}
+    optimal = app_client().post(PATH, json=body).json()
+
+    def unit_kwh(answer):
+        return answer["routes"][0]["candidates"][0]["energy_kwh_mean"]["refrigeration"]
+
+    assert unit_kwh(optimal) < unit_kwh(thermostat)
+
+
+def test_more_route_days_than_the_server_takes_is_a_413_naming_the_limit():
+    small = app_client(max_route_days=100)
+    response = small.post(PATH, json=ELECTRIFICATION_EXAMPLE)
+    assert response.status_code == 413
+    assert response.json()["errors"][0]["field"] == "routes"
+    assert "522 route-days × candidates" in response.json()["detail"]
+    assert "at most 100" in response.json()["detail"]
+    sync = app_client(max_sync_route_days=100).post(PATH, json=ELECTRIFICATION_EXAMPLE)
+    assert sync.status_code == 413 and "type electrification" in sync.json()["detail"]
+
+
+def _with(change) -> dict:
+    body = copy.deepcopy(ELECTRIFICATION_EXAMPLE)
+    change(body)
+    return body
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        (lambda b: b["routes"][0].update(days=["2026-03-02", "2026-03-01"]), "routes[0].days"),
+        (lambda b: b["routes"][0].update(days=["2025-03-02"]), "routes[0].days[0]"),
+        (lambda b: b["routes"][0].update(days={"weekdays": ["mon", "mo"]}), "routes[0].days"),
+        (lambda b: b["routes"][0].update(days=[]), "routes[0].days"),
+        (lambda b: b["routes"][0].update(start_time="25:00"), "routes[0].start_time"),
+        (lambda b: b["routes"][1].update(id="inner-city"), "routes[1].id"),
+        (lambda b: b["routes"][0]["stops"][1].update(lat=91), "routes[0].stops[1].lat"),
+        (lambda b: b["routes"][0].update(stops=[]), "routes[0].stops"),
+        (lambda b: b.update(candidates=[]), "candidates"),
+        (lambda b: b["candidates"][1].update(id="reefer-40"), "candidates[1].id"),
+        (
+            lambda b: b["candidates"][0]["vehicle"].update(preset="tesla"),
+            "candidates[0].vehicle.preset",
+        ),
+        (
+            lambda b: b["candidates"][0]["battery"].update(usable_capacity_kwh=-1),
+            "candidates[0].battery.usable_capacity_kwh",
+        ),
+        (lambda b: b["chargers"][0].update(power_kw=0), "chargers[0].power_kw"),
+        (lambda b: b["chargers"][0].update(where="roof"), "chargers[0].where"),
+        (lambda b: b.update(weather={"source": "archive"}), "weather.source"),
+        (lambda b: b.update(year=1800), "year"),
+        (lambda b: b.update(timezone="Mars/Olympus"), "timezone"),
+        (lambda b: b.update(routes=[]), "routes"),
+    ],
+)
+def test_bad_studies_name_the_field(change, field):
+    response = app_client().post(PATH, json=_with(change))
+    assert response.status_code == 422, response.text
+    assert response.headers["content-type"] == "application/problem+json"
+    assert field in [e["field"] for e in response.json()["errors"]], response.json()

@@ -1,0 +1,239 @@
+"""The electrification study: each route-day is the product's own plan of that day (the same
+figures as /v1/plans driving the stops in the order given), the days a battery covers follow
+from the capacity each day needs, the worst days and their reasons, the fleet's recharge, and
+the dates checked."""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import numpy as np
+import pytest
+
+from core.exceptions import CoreError
+from core.params import PRESETS, Depot, Stop
+from core.planning.electrification.model import (
+    Candidate,
+    ChargeOption,
+    DrivenRoute,
+    ElectrificationProblem,
+    Weekdays,
+)
+from core.planning.electrification.study import (
+    carrying,
+    route_dates,
+    route_year,
+    study,
+    topped_up,
+)
+from core.planning.model import PlanProblem
+from core.planning.round.planner import plan
+from tests.app.serving import vienna_stops
+
+DEPOT = Depot(id="depot", lat=48.21, lon=16.37)
+VAN = PRESETS["ev-van-3.5t-reefer"].van()
+MONTHS = [dt.date(2026, m, 15) for m in range(1, 13)]
+LUNCH = ChargeOption(where="depot", power_kw=22, minutes=30)
+
+
+def stops(count: int, seed: int = 3) -> list[Stop]:
+    rng = np.random.default_rng(seed)
+    return [Stop.model_validate(s) for s in vienna_stops(rng, count, 300, 120, 10)]
+
+
+def frozen_van(capacity_kwh: float | None = None):
+    """Frozen goods at −22 °C and no cab HVAC: the refrigeration sets the day's weather part,
+    and the hottest days need the most."""
+    box = VAN.cargo_box.model_copy(update={"product": "frozen", "setpoint_c": -22.0})
+    vehicle = VAN.vehicle.model_copy(update={"cabin_hvac_enabled": False})
+    van = VAN.model_copy(update={"cargo_box": box, "vehicle": vehicle})
+    if capacity_kwh is not None:
+        battery = van.battery.model_copy(update={"usable_capacity_kwh": capacity_kwh})
+        van = van.model_copy(update={"battery": battery})
+    return van
+
+
+def problem(route: DrivenRoute, *vans, chargers=()) -> ElectrificationProblem:
+    return ElectrificationProblem(
+        year=2026,
+        timezone="Europe/Vienna",
+        routes=[route],
+        candidates=[Candidate(id=f"c{k}", van=van) for k, van in enumerate(vans)],
+        chargers=list(chargers),
+    )
+
+
+def route(days=MONTHS, count: int = 20, route_id: str = "r1") -> DrivenRoute:
+    return DrivenRoute(id=route_id, depot=DEPOT, stops=stops(count), start_time="10:00", days=days)
+
+
+def test_each_route_day_is_the_plan_of_that_day_in_the_order_driven():
+    """The study's day is what POST /v1/plans answers for the same stops, kept in order, on
+    that date: the same energy per consumer and the same lowest charge."""
+    r = route()
+    for date in (MONTHS[0], MONTHS[6]):
+        (day,) = route_year(problem(r, VAN), r, VAN, [date])
+        planned = plan(
+            PlanProblem(
+                date=date,
+                timezone="Europe/Vienna",
+                depot=DEPOT,
+                stops=r.stops,
+                start_time=r.start_time,
+                keep_order=True,
+                van=VAN,
+            )
+        )
+        for name in ("traction", "auxiliaries", "cabin", "refrigeration"):
+            assert day.energy_kwh[name] == pytest.approx(planned.energy_kwh[name], rel=1e-9)
+        assert day.battery.min_soc == pytest.approx(planned.battery.min_soc, rel=1e-9)
+        assert day.distance_m == pytest.approx(planned.distance_m, rel=1e-9)
+
+
+def test_a_battery_covers_the_days_that_need_no_more_than_it_holds():
+    """Each day's required capacity decides it: a candidate with the year's largest covers
+    every day, one with its 95th percentile at least 95 % of them, and one just below the
+    smallest none."""
+    r = route()
+    (outcome,) = study(problem(r, frozen_van())).routes[0].candidates
+    required = sorted(
+        d.battery.required_capacity_kwh
+        for d in route_year(problem(r, VAN), r, frozen_van(), MONTHS)
+    )
+    assert outcome.required_kwh_max == pytest.approx(required[-1])
+    # 12 days: 95 % of them is 11.4, so the 12th smallest (nearest rank)
+    assert outcome.required_kwh_p95 == pytest.approx(required[11])
+    for capacity, feasible in ((required[-1] + 0.01, 12), (required[0] - 0.01, 0)):
+        result = study(problem(r, frozen_van(capacity)))
+        assert result.routes[0].candidates[0].days_feasible == feasible
+        assert result.fleet[0].routes_all_year == (feasible == 12)
+
+
+def test_a_route_that_fails_only_on_the_hottest_days_is_named_with_them():
+    """Frozen goods, no cab HVAC: July needs the most. A battery between July's need and every
+    other month's covers 11 of the 12 days; July is the worst day, for the heat."""
+    r = route()
+    days = route_year(problem(r, VAN), r, frozen_van(), MONTHS)
+    need = {d.date: d.battery.required_capacity_kwh for d in days}
+    hottest = max(days, key=lambda d: d.t_max_c).date
+    assert max(need, key=need.__getitem__) == hottest == dt.date(2026, 7, 15)
+    second = sorted(need.values())[-2]
+    capacity = (second + need[hottest]) / 2
+    (outcome,) = study(problem(r, frozen_van(capacity))).routes[0].candidates
+    assert outcome.days_feasible == 11 and outcome.share_feasible == pytest.approx(11 / 12)
+    worst = outcome.worst_days[0]
+    assert worst.date == hottest and worst.reason == "heat" and worst.min_soc < 0.1
+    assert "refrigeration" in worst.detail and "-0 " not in worst.detail
+
+
+def test_a_charge_covers_the_days_whose_lack_it_stores():
+    """22 kW for 30 min at lunch stores 22 × 0.5 × efficiency; a day lacking less is covered
+    with it, one lacking more is not (the van's own power cap applies); two charges add up."""
+    van = frozen_van()
+    stored_kwh = 22 * 0.5 * van.battery.charging_efficiency
+    r = route()
+    (day,) = route_year(problem(r, van), r, van, [MONTHS[6]])
+    short = van.model_copy(
+        update={
+            "battery": van.battery.model_copy(
+                update={"usable_capacity_kwh": day.battery.required_capacity_kwh - 1.0}
+            )
+        }
+    )
+    (lacking,) = route_year(problem(r, short), r, short, [MONTHS[6]])
+    assert not lacking.battery.feasible and 0 < -lacking.battery.margin_kwh < stored_kwh
+    assert topped_up(lacking.battery, short, [LUNCH])
+    assert not topped_up(
+        lacking.battery, short, [ChargeOption(where="depot", power_kw=22, minutes=1)]
+    )
+    capped = short.model_copy(
+        update={"battery": short.battery.model_copy(update={"max_charge_power_kw": 1.0})}
+    )
+    assert not topped_up(lacking.battery, capped, [LUNCH])
+    assert not topped_up(lacking.battery, short, [])
+    halves = [LUNCH.model_copy(update={"minutes": 15}), LUNCH.model_copy(update={"minutes": 15})]
+    assert topped_up(lacking.battery, short, halves)
+    result = study(problem(r, short, chargers=[LUNCH]))
+    outcome = result.routes[0].candidates[0]
+    assert outcome.days_feasible_with_charging >= outcome.days_feasible + 1
+
+
+def test_the_depot_recharges_the_days_driven_on_one_charge():
+    """Two routes on the same dates: the depot's energy on a date is both vans' recharge, its
+    peak power each one's over the hours it stands until the next day's departure."""
+    first, second = route(MONTHS[6:8], 12, "a"), route(MONTHS[6:8], 16, "b")
+    p = problem(first, VAN).model_copy(update={"routes": [first, second]})
+    result = study(p)
+    years = [route_year(p, r, VAN, r.days) for r in (first, second)]
+    by_date = [sum(y[k].battery.recharge_kwh for y in years) for k in range(2)]
+    power = [
+        sum(y[k].battery.recharge_kwh / ((86_400 - y[k].duration_s) / 3600) for y in years)
+        for k in range(2)
+    ]
+    assert result.fleet[0].depot_kwh_max_day == pytest.approx(max(by_date))
+    assert result.fleet[0].depot_kw_peak == pytest.approx(max(power))
+    assert result.route_days == 4 and result.weather_source == "climatology"
+
+
+def test_weekdays_are_every_such_date_of_the_year():
+    weekdays = route(Weekdays(weekdays=["mon", "tue", "wed", "thu", "fri"]))
+    dates = route_dates(weekdays, 2026, "days")
+    assert len(dates) == 261 and dates[0] == dt.date(2026, 1, 1)  # a Thursday
+    assert {d.weekday() for d in dates} == {0, 1, 2, 3, 4}
+    sundays = route_dates(route(Weekdays(weekdays=["sun"])), 2024, "days")  # a leap year
+    assert len(sundays) == 52 and sundays[-1] == dt.date(2024, 12, 29)
+
+
+@pytest.mark.parametrize(
+    ("change", "field", "words"),
+    [
+        (lambda r, p: p.model_copy(update={"year": 2025}), "routes[0].days[0]", "not in"),
+        (
+            lambda r, p: p.model_copy(update={"routes": [r, r]}),
+            "routes[1].id",
+            "used twice",
+        ),
+        (
+            lambda r, p: p.model_copy(update={"candidates": p.candidates * 2}),
+            "candidates[1].id",
+            "used twice",
+        ),
+        (
+            lambda r, p: p.model_copy(
+                update={
+                    "routes": [
+                        r.model_copy(
+                            update={"stops": [r.stops[0].model_copy(update={"delivery_kg": 5000})]}
+                        )
+                    ]
+                }
+            ),
+            "routes[0].stops",
+            "with candidate 'c0': ",
+        ),
+    ],
+)
+def test_a_study_that_cannot_run_names_the_field(change, field, words):
+    r = route(MONTHS[:2])
+    with pytest.raises(CoreError) as caught:
+        study(change(r, problem(r, VAN)))
+    assert caught.value.field == field and words in caught.value.message
+
+
+def test_dates_out_of_order_are_refused_with_their_place():
+    with pytest.raises(ValueError, match=r"days\[1\]"):
+        route([MONTHS[1], MONTHS[0]])
+
+
+def test_a_routes_goods_go_into_each_candidates_box():
+    """Frozen goods on a route: the reefer's box (set to 4 °C) runs at the frozen band's middle,
+    −24 °C, and holds them; chilled dairy keeps its 4 °C (inside 0–6 °C)."""
+    frozen = route(MONTHS[6:7]).model_copy(update={"product": "frozen"})
+    dairy = frozen.model_copy(update={"product": "chilled-dairy"})
+    assert carrying(VAN, frozen).cargo_box.setpoint_c == -24.0
+    assert carrying(VAN, dairy).cargo_box.setpoint_c == VAN.cargo_box.setpoint_c == 4.0
+    plain = route(MONTHS[6:7])
+    cold = study(problem(frozen, VAN)).routes[0].candidates[0]
+    warm = study(problem(plain, VAN)).routes[0].candidates[0]
+    assert cold.energy_kwh_mean["refrigeration"] > warm.energy_kwh_mean["refrigeration"]
+    assert cold.cold_chain_days_broken == 0
