@@ -10,7 +10,7 @@ from __future__ import annotations
 import datetime as dt
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -19,7 +19,15 @@ from numpy.typing import ArrayLike
 from core.arrays import FloatArray, interval_rates, uniform_interp
 from core.clock import SECONDS_PER_DAY, check_representable, local_clock
 from core.exceptions import InvalidParameterError
-from core.params import ChargingSpell, DoorOpening, Interval, Location, VanParams, Weather
+from core.params import (
+    BatteryParams,
+    ChargingSpell,
+    DoorOpening,
+    Interval,
+    Location,
+    VanParams,
+    Weather,
+)
 from core.physics import battery as battery_model
 from core.physics.cabin import CAB_SETPOINT_C, auxiliaries_power_w, cab_power_w, cabin_hvac_power_w
 from core.physics.cargo import BoxResult, precondition_energy_j, refrigeration
@@ -297,7 +305,7 @@ def simulate(
         dt_s,
         outside,
         (power, box),
-        _battery(van, power, dt_s, outside, trace.charging),
+        _battery(van.battery, power, dt_s, (outside.ambient_c, outside.start_c), trace.charging),
         grid_j / battery_model.JOULES_PER_KWH if departs_depot else 0.0,
     )
 
@@ -473,27 +481,45 @@ def _consumers(
     return power, box, cab_gap_j
 
 
+def with_battery(result: SimulationResult, battery: BatteryParams) -> SimulationResult:
+    """The day ``result`` simulated, with ``battery`` for the van's: its state of charge,
+    verdict and loss in the cold or heat. Exact for a day without charging — no consumer
+    depends on the battery (its capacity, reserve or departure charge), only the energy it
+    gives them does — so candidates that differ in their battery alone share one simulation."""
+    if result.charges:
+        raise ValueError("a day with charges depends on the battery: simulate it again")
+    dt_s = float(result.time_s[1] - result.time_s[0]) if result.time_s.size > 1 else 1.0
+    soc, verdict, loss_j, _ = _battery(
+        battery, result.power_w, dt_s, (result.ambient_c, float(result.ambient_c[0])), ()
+    )
+    return replace(
+        result, soc=soc, battery=verdict, battery_loss_kwh=loss_j / battery_model.JOULES_PER_KWH
+    )
+
+
 def _battery(
-    van: VanParams,
+    battery: BatteryParams,
     power_w: dict[str, FloatArray],
     dt_s: float,
-    outside: _Environment,
+    ambient: tuple[FloatArray, float],
     charging: Sequence[ChargingSpell],
 ) -> tuple[FloatArray, battery_model.BatteryVerdict, float, list[ChargeOutcome]]:
     """The state of charge at every sample, the verdict, the battery's own loss in the cold
-    or heat [J], and what each charging spell did. Plugged in, the consumers run from the grid
-    and the battery charges along its curve from the state of charge it arrived with."""
-    consumer_j = sum(power_w.values(), np.zeros(outside.ambient_c.size)) * dt_s
-    drawn_j = battery_model.battery_energy_j(van.battery, consumer_j, outside.ambient_c)
-    usable_share = battery_model.capacity_factor(van.battery, outside.start_c)
+    or heat [J], and what each charging spell did; ``ambient``: the outside temperature of
+    each step and at the start [°C]. Plugged in, the consumers run from the grid and the
+    battery charges along its curve from the state of charge it arrived with."""
+    ambient_c, start_c = ambient
+    consumer_j = sum(power_w.values(), np.zeros(ambient_c.size)) * dt_s
+    drawn_j = battery_model.battery_energy_j(battery, consumer_j, ambient_c)
+    usable_share = battery_model.capacity_factor(battery, start_c)
     charges = []
     for spell in sorted(charging, key=lambda c: c.start_s):
         first = min(round(spell.start_s / dt_s), drawn_j.size)
         last = min(round((spell.start_s + spell.duration_s) / dt_s), drawn_j.size)
         grid_loads_j = float(consumer_j[first:last].sum())
         drawn_j[first:last] = 0.0
-        before = float(battery_model.discharge(van.battery, drawn_j[:first], usable_share)[0][-1])
-        curve = charge_curve(van.battery, spell.power_kw * WATTS_PER_KW, usable_share)
+        before = float(battery_model.discharge(battery, drawn_j[:first], usable_share)[0][-1])
+        curve = charge_curve(battery, spell.power_kw * WATTS_PER_KW, usable_share)
         # A battery run below empty (infeasible already) charges from empty; its shortfall stays.
         reached = curve.soc_after(max(before, 0.0), np.arange(0, last - first + 1) * dt_s)
         drawn_j[first:last] = -np.diff(reached) * curve.capacity_j
@@ -503,11 +529,11 @@ def _battery(
                 soc_before=before,
                 soc_after=before + float(reached[-1] - reached[0]),
                 stored_j=stored_j,
-                charge_grid_j=stored_j / van.battery.charging_efficiency,
+                charge_grid_j=stored_j / battery.charging_efficiency,
                 consumers_grid_j=grid_loads_j,
             )
         )
-    soc, verdict = battery_model.discharge(van.battery, drawn_j, usable_share)
+    soc, verdict = battery_model.discharge(battery, drawn_j, usable_share)
     charged_j = sum(c.stored_j for c in charges)
     # Never negative (the derating takes more and stores less); clipped of float noise.
     loss_j = max(

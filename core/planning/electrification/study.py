@@ -21,7 +21,7 @@ from core.exceptions import CoreError, InvalidParameterError
 from core.params import Location, VanParams, product_band
 from core.physics.battery import BatteryVerdict
 from core.physics.cold_chain import check_cold_chain
-from core.physics.simulate import CONSUMERS, SimulationResult, simulate
+from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
 from core.planning.day.scene import legs_for, round_places
 from core.planning.day.timeline import PLAN_DT_S, Timeline, build_timeline, rest_after
 from core.planning.electrification.model import (
@@ -108,9 +108,8 @@ def study(
     for i, route in enumerate(problem.routes):
         dates = route_dates(route, problem.year, f"routes[{i}].days")
         try:
-            year = {
-                c.id: route_year(problem, route, c.van, dates, router) for c in problem.candidates
-            }
+            vans = {c.id: c.van for c in problem.candidates}
+            year = route_year(problem, route, vans, dates, router)
         except CoreError as error:
             raise error.under(f"routes[{i}]") from None
         years.append(year)
@@ -162,31 +161,41 @@ def _round(
 def route_year(
     problem: ElectrificationProblem,
     route: DrivenRoute,
-    van: VanParams,
+    vans: dict[str, VanParams],
     dates: Sequence[dt.date],
     router: RoadRouter | None = None,
-) -> list[DayOutcome]:
-    """The route laid out once for ``van`` and simulated on each of ``dates``."""
-    first = _round(problem, route, van, dates[0])
-    van = first.van
-    timeline = _laid_out(first, router)
+) -> dict[str, list[DayOutcome]]:
+    """The route laid out once for each kind of van among ``vans`` (by candidate id) and
+    simulated on each of ``dates``; vans that differ in their battery alone share the
+    simulation (:func:`core.physics.simulate.with_battery`)."""
+    kinds: dict[str, list[str]] = {}
+    for candidate_id, van in vans.items():
+        key = carrying(van, route).model_dump_json(exclude={"battery"})
+        kinds.setdefault(key, []).append(candidate_id)
+    out: dict[str, list[DayOutcome]] = {candidate_id: [] for candidate_id in vans}
     location = problem.location or Location(lat=route.depot.lat, lon=route.depot.lon)
-    out = []
-    for date in dates:
-        start, _ = departure(date, route.start_time, problem.timezone, route.depot.lon)
-        result = simulate(
-            timeline.speed,
-            PLAN_DT_S,
-            start,
-            location,
-            van,
-            grade=timeline.grade,
-            payload_kg=timeline.payload,
-            door_openings=timeline.doors,
-            parked=timeline.parked,
-            heading_deg=timeline.heading,
-        )
-        out.append(_day(date, van, result, problem.chargers))
+    for ids in kinds.values():
+        first = _round(problem, route, vans[ids[0]], dates[0])
+        timeline = _laid_out(first, router)
+        for date in dates:
+            start, _ = departure(date, route.start_time, problem.timezone, route.depot.lon)
+            result = simulate(
+                timeline.speed,
+                PLAN_DT_S,
+                start,
+                location,
+                first.van,
+                grade=timeline.grade,
+                payload_kg=timeline.payload,
+                door_openings=timeline.doors,
+                parked=timeline.parked,
+                heading_deg=timeline.heading,
+            )
+            for candidate_id in ids:
+                battery = vans[candidate_id].battery
+                own = result if candidate_id == ids[0] else with_battery(result, battery)
+                van = first.van.model_copy(update={"battery": battery})
+                out[candidate_id].append(_day(date, van, own, problem.chargers))
     return out
 
 

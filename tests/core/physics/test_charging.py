@@ -13,7 +13,7 @@ import pytest
 from core.exceptions import InvalidParameterError
 from core.params import BatteryParams, ChargingSpell, Interval, Location, VanParams, Weather
 from core.physics.charging import charge_curve
-from core.physics.simulate import simulate
+from core.physics.simulate import simulate, with_battery
 
 KWH = 3.6e6
 VIENNA = Location(lat=48.21, lon=16.37)
@@ -122,6 +122,13 @@ def test_a_plugged_in_spell_charges_along_the_curve_while_the_consumers_run_from
     assert plugged.soc[2400] == pytest.approx(after, rel=1e-9)
     assert plugged.soc[-1] == pytest.approx(after - load_j[2400:].sum() / capacity_j, rel=1e-9)
     assert unplugged.soc[-1] == pytest.approx(0.5 - load_j.sum() / capacity_j, rel=1e-9)
+    # another battery on the same day: by hand without charging, refused with charging
+    larger = BatteryParams(usable_capacity_kwh=80.0, initial_soc=0.5)
+    assert with_battery(unplugged, larger).soc[-1] == pytest.approx(
+        0.5 - load_j.sum() / (80 * KWH), rel=1e-9
+    )
+    with pytest.raises(ValueError, match="charges"):
+        with_battery(plugged, larger)
 
 
 def test_a_long_spell_fills_the_battery_through_the_taper_and_no_further():

@@ -63,6 +63,11 @@ def problem(route: DrivenRoute, *vans, chargers=()) -> ElectrificationProblem:
     )
 
 
+def days_of(p: ElectrificationProblem, r: DrivenRoute, van, dates):
+    """The route's days for one van, as the study simulates them."""
+    return route_year(p, r, {"van": van}, dates)["van"]
+
+
 def route(days=MONTHS, count: int = 20, route_id: str = "r1") -> DrivenRoute:
     return DrivenRoute(id=route_id, depot=DEPOT, stops=stops(count), start_time="10:00", days=days)
 
@@ -72,7 +77,7 @@ def test_each_route_day_is_the_plan_of_that_day_in_the_order_driven():
     that date: the same energy per consumer and the same lowest charge."""
     r = route()
     for date in (MONTHS[0], MONTHS[6]):
-        (day,) = route_year(problem(r, VAN), r, VAN, [date])
+        (day,) = days_of(problem(r, VAN), r, VAN, [date])
         planned = plan(
             PlanProblem(
                 date=date,
@@ -97,8 +102,7 @@ def test_a_battery_covers_the_days_that_need_no_more_than_it_holds():
     r = route()
     (outcome,) = study(problem(r, frozen_van())).routes[0].candidates
     required = sorted(
-        d.battery.required_capacity_kwh
-        for d in route_year(problem(r, VAN), r, frozen_van(), MONTHS)
+        d.battery.required_capacity_kwh for d in days_of(problem(r, VAN), r, frozen_van(), MONTHS)
     )
     assert outcome.required_kwh_max == pytest.approx(required[-1])
     # 12 days: 95 % of them is 11.4, so the 12th smallest (nearest rank)
@@ -113,7 +117,7 @@ def test_a_route_that_fails_only_on_the_hottest_days_is_named_with_them():
     """Frozen goods, no cab HVAC: July needs the most. A battery between July's need and every
     other month's covers 11 of the 12 days; July is the worst day, for the heat."""
     r = route()
-    days = route_year(problem(r, VAN), r, frozen_van(), MONTHS)
+    days = days_of(problem(r, VAN), r, frozen_van(), MONTHS)
     need = {d.date: d.battery.required_capacity_kwh for d in days}
     hottest = max(days, key=lambda d: d.t_max_c).date
     assert max(need, key=need.__getitem__) == hottest == dt.date(2026, 7, 15)
@@ -132,7 +136,7 @@ def test_a_charge_covers_the_days_whose_lack_it_stores():
     van = frozen_van()
     stored_kwh = 22 * 0.5 * van.battery.charging_efficiency
     r = route()
-    (day,) = route_year(problem(r, van), r, van, [MONTHS[6]])
+    (day,) = days_of(problem(r, van), r, van, [MONTHS[6]])
     short = van.model_copy(
         update={
             "battery": van.battery.model_copy(
@@ -140,7 +144,7 @@ def test_a_charge_covers_the_days_whose_lack_it_stores():
             )
         }
     )
-    (lacking,) = route_year(problem(r, short), r, short, [MONTHS[6]])
+    (lacking,) = days_of(problem(r, short), r, short, [MONTHS[6]])
     assert not lacking.battery.feasible and 0 < -lacking.battery.margin_kwh < stored_kwh
     assert topped_up(lacking.battery, short, [LUNCH])
     assert not topped_up(
@@ -164,7 +168,7 @@ def test_the_depot_recharges_the_days_driven_on_one_charge():
     first, second = route(MONTHS[6:8], 12, "a"), route(MONTHS[6:8], 16, "b")
     p = problem(first, VAN).model_copy(update={"routes": [first, second]})
     result = study(p)
-    years = [route_year(p, r, VAN, r.days) for r in (first, second)]
+    years = [days_of(p, r, VAN, r.days) for r in (first, second)]
     by_date = [sum(y[k].battery.recharge_kwh for y in years) for k in range(2)]
     power = [
         sum(y[k].battery.recharge_kwh / ((86_400 - y[k].duration_s) / 3600) for y in years)
@@ -237,3 +241,24 @@ def test_a_routes_goods_go_into_each_candidates_box():
     warm = study(problem(plain, VAN)).routes[0].candidates[0]
     assert cold.energy_kwh_mean["refrigeration"] > warm.energy_kwh_mean["refrigeration"]
     assert cold.cold_chain_days_broken == 0
+
+
+def test_batteries_alone_apart_share_one_simulation_and_get_their_own_verdicts():
+    """Three batteries of one van (capacities, reserve, departure charge): the study simulates
+    the day once and gives each battery the verdict and loss its own simulation gives."""
+    r = route(MONTHS[:1])
+    batteries = [
+        VAN.battery.model_copy(update=changes)
+        for changes in (
+            {"usable_capacity_kwh": 40.0},
+            {"usable_capacity_kwh": 70.0, "min_soc": 0.2},
+            {"usable_capacity_kwh": 55.0, "initial_soc": 0.8},
+        )
+    ]
+    vans = {f"b{k}": VAN.model_copy(update={"battery": b}) for k, b in enumerate(batteries)}
+    shared = route_year(problem(r, VAN), r, vans, MONTHS[:1])
+    for name, van in vans.items():
+        (alone,) = days_of(problem(r, van), r, van, MONTHS[:1])
+        (day,) = shared[name]
+        assert day.battery == alone.battery
+        assert day.energy_kwh == pytest.approx(alone.energy_kwh, rel=1e-12)
