@@ -33,6 +33,7 @@ def electrification_problem(
         routes=request.routes,
         candidates=candidates,
         chargers=request.chargers,
+        include_days=request.include_days,
     )
     simulated = route_days(problem) * len(candidates)
     said = f"{simulated:,} route-days × candidates"

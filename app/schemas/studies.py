@@ -168,6 +168,11 @@ class ElectrificationRequest(ApiModel):
     weather: StudyWeather = Field(
         default_factory=StudyWeather, description="Where each date's weather comes from."
     )
+    include_days: bool = Field(
+        False,
+        description="Every route-day's figures in the answer (candidates[].days[]: the viewer's "
+        "heat map and coverage curve).",
+    )
 
 
 class ElectrificationResponse(ApiModel, ElectrificationResult):

@@ -129,3 +129,25 @@ def test_bad_studies_name_the_field(change, field):
     assert response.status_code == 422, response.text
     assert response.headers["content-type"] == "application/problem+json"
     assert field in [e["field"] for e in response.json()["errors"]], response.json()
+
+
+def test_every_day_is_listed_when_asked_and_agrees_with_the_summary():
+    body = _with(lambda b: b.update(include_days=True))
+    answer = app_client().post(PATH, json=body).json()
+    for route in answer["routes"]:
+        for outcome in route["candidates"]:
+            days = outcome["days"]
+            assert len(days) == outcome["days_total"]
+            assert [d["date"] for d in days] == sorted(d["date"] for d in days)
+            assert sum(d["margin_kwh"] >= 0 for d in days) == outcome["days_feasible"]
+            assert (
+                sum(d["covered_with_charging"] for d in days)
+                == (outcome["days_feasible_with_charging"])
+            )
+            assert max(d["required_kwh"] for d in days) == outcome["required_kwh_max"]
+            assert min(d["min_soc"] for d in days) == outcome["worst_days"][0]["min_soc"]
+    assert all(
+        c["days"] is None
+        for r in app_client().post(PATH, json=ELECTRIFICATION_EXAMPLE).json()["routes"]
+        for c in r["candidates"]
+    )

@@ -10,6 +10,7 @@ import csv
 import io
 import json
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -631,4 +632,35 @@ def test_a_stop_pinned_to_another_van_is_planned_on_it(server, page, tmp_path):
     shot(tab, "16-pinned-and-planned-again")
     shown.get_by_test_id("pin").click()
     expect(tab.get_by_test_id("replan")).to_be_disabled()
+    assert outside == []
+
+
+def test_the_electrification_study_shows_its_heat_map_and_coverage_curve(server, page):
+    tab, outside = page
+    tab.goto(f"{server.url}/viewer")
+    tab.get_by_test_id("api-key").fill(KEY)
+    tab.get_by_test_id("api-key").dispatch_event("change")
+    tab.get_by_test_id("study-example").click()
+    expect(tab.get_by_test_id("study-json")).to_have_value(re.compile("long-day"))
+    tab.get_by_test_id("study-run").click()
+    expect(tab.get_by_test_id("study-status")).to_contain_text("261 route-days", timeout=120_000)
+    answer = tab.evaluate("window.coldrouteStudy.answer()")
+    heat = tab.get_by_test_id("study-heatmap")
+    # one row per route, one cell per day driven, coloured as the answer's own days say
+    for route in answer["routes"]:
+        outcome = route["candidates"][0]  # the first candidate is shown first
+        row = heat.locator(f"tr[data-route='{route['id']}']")
+        assert row.locator(".day").count() == outcome["days_total"]
+        assert row.locator(".day.covered").count() == outcome["days_feasible"]
+        charged = outcome["days_feasible_with_charging"] - outcome["days_feasible"]
+        assert row.locator(".day.charged").count() == charged
+    expect(tab.get_by_test_id("study-fleet")).to_contain_text("reefer-40: 1 of 2 route(s)")
+    shot(tab, "17-electrification-study")
+    # the larger battery: every day of both routes on one charge, the curve reaching 100 %
+    tab.get_by_test_id("study-candidate").select_option("reefer-70")
+    expect(tab.get_by_test_id("study-fleet")).to_contain_text("reefer-70: 2 of 2 route(s)")
+    assert heat.locator(".day.short").count() == 0
+    capacities, covered = tab.evaluate("window.coldrouteStudy.coverage()")
+    assert covered[-1] == 100 and capacities == sorted(capacities)
+    assert capacities[-1] <= 70
     assert outside == []

@@ -126,6 +126,9 @@ class ElectrificationProblem(Params):
         description="The charges a day may take, together; empty: a day is covered on one "
         "charge alone.",
     )
+    include_days: bool = Field(
+        False, description="Every route-day's figures in the answer (days[] per candidate)."
+    )
 
 
 Reason = Literal["heat", "cold", "distance"]
@@ -148,6 +151,24 @@ class WorstDay(Result):
     t_min_c: float = Field(..., description="Coldest moment of the route's day [°C].")
     t_max_c: float = Field(..., description="Warmest moment of the route's day [°C].")
     detail: str = Field(..., description="The figures behind the reason, in a sentence.")
+
+
+class DaySummary(Result):
+    """One day of one candidate on one route."""
+
+    date: dt.date = Field(..., description="The date.")
+    min_soc: float = Field(..., description="Lowest state of charge [–]; negative: empty.")
+    margin_kwh: float = Field(
+        ..., description="Energy above the reserve at the lowest point [kWh]; negative: lacking."
+    )
+    required_kwh: float = Field(
+        ..., description="Smallest usable capacity that keeps the reserve that day [kWh]."
+    )
+    energy_kwh: float = Field(..., description="The day's energy, the battery's loss in [kWh].")
+    covered_with_charging: bool = Field(
+        ..., description="Covered on one charge, or with the chargers' charges."
+    )
+    cold_chain_holds: bool = Field(..., description="The goods stayed in their band.")
 
 
 class CandidateOutcome(Result):
@@ -181,6 +202,9 @@ class CandidateOutcome(Result):
         ..., description="Days the goods left their band (0 without a product)."
     )
     worst_days: list[WorstDay] = Field(..., description="The days it ran lowest, lowest first.")
+    days: list[DaySummary] | None = Field(
+        None, description="Every day, in date order, when include_days asks; else null."
+    )
 
 
 class RouteOutcome(Result):

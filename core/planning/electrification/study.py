@@ -113,7 +113,7 @@ def study(
         except CoreError as error:
             raise error.under(f"routes[{i}]") from None
         years.append(year)
-        outcomes.append(route_outcome(route.id, year, problem.chargers))
+        outcomes.append(route_outcome(route.id, year, problem.chargers, problem.include_days))
         if progress is not None:
             progress(len(dates))
     runtime_s = time.perf_counter() - started

@@ -15,6 +15,7 @@ from core.physics.battery import BatteryVerdict
 from core.planning.electrification.model import (
     CandidateOutcome,
     ChargeOption,
+    DaySummary,
     FleetOutcome,
     Reason,
     RouteOutcome,
@@ -49,14 +50,36 @@ class DayOutcome:
 
 
 def route_outcome(
-    route_id: str, year: dict[str, list[DayOutcome]], chargers: Sequence[ChargeOption]
+    route_id: str,
+    year: dict[str, list[DayOutcome]],
+    chargers: Sequence[ChargeOption],
+    include_days: bool = False,
 ) -> RouteOutcome:
-    """One route: each candidate's ``year`` of days (by candidate id) summed up."""
+    """One route: each candidate's ``year`` of days (by candidate id) summed up, with every
+    day's figures when ``include_days``."""
     first = next(iter(year.values()))[0]
     return RouteOutcome(
         id=route_id,
         distance_km=first.distance_m / 1000.0,
-        candidates=[candidate_outcome(cid, days, chargers) for cid, days in year.items()],
+        candidates=[
+            candidate_outcome(cid, days, chargers).model_copy(
+                update={"days": [summary(d) for d in days] if include_days else None}
+            )
+            for cid, days in year.items()
+        ],
+    )
+
+
+def summary(day: DayOutcome) -> DaySummary:
+    """One day's figures as the answer lists them."""
+    return DaySummary(
+        date=day.date,
+        min_soc=day.battery.min_soc,
+        margin_kwh=day.battery.margin_kwh,
+        required_kwh=day.battery.required_capacity_kwh,
+        energy_kwh=day.energy_kwh["total"],
+        covered_with_charging=day.covered_with_top_up,
+        cold_chain_holds=day.cold_chain_holds,
     )
 
 
