@@ -11,9 +11,10 @@ import math
 import time
 from typing import Any
 
+import httpx
 import numpy as np
 
-from benchmarks.common import print_table
+from benchmarks.common import print_table, running_server
 from core.arrays import keep_heap
 from core.params import PRESETS, Depot, Stop
 from core.planning.electrification.model import (
@@ -75,36 +76,63 @@ def fleet_problem(routes: int, days: int, strategy: str, seed: int = 34) -> Elec
     )
 
 
+def _over_http(url: str, problem: ElectrificationProblem) -> dict[str, Any]:
+    """The study sent as POST /v1/studies/electrification (its routes shared out over the
+    server's workers)."""
+    body = problem.model_dump(mode="json", exclude={"candidates"}) | {
+        "candidates": [
+            {"id": c.id, "vehicle": {"preset": "ev-van-3.5t-reefer"}}
+            | {"battery": {"usable_capacity_kwh": c.van.battery.usable_capacity_kwh}}
+            for c in problem.candidates
+        ],
+        "refrigeration": problem.candidates[0].van.refrigeration.model_dump(mode="json"),
+    }
+    response = httpx.post(f"{url}/v1/studies/electrification", json=body, timeout=3600)
+    response.raise_for_status()
+    return dict(response.json())
+
+
+def _row(name: str, size: str, wall_s: float, simulated: int, fleet: list[Any]) -> list[Any]:
+    per_s = simulated / wall_s
+    full = 50 * 365 * len(BATTERIES_KWH)
+    return [name, size, f"{wall_s:.1f}", f"{per_s:.0f}", f"{full / per_s:,.0f}", fleet]
+
+
 def main(routes: int = 50, days: int = 12) -> None:
     keep_heap()  # as the service's workers do
     rows: list[list[Any]] = []
-    for strategy in ("thermostat", "optimal"):
-        problem = fleet_problem(routes, days, strategy)
+    env = {"COLDROUTE_WORKERS": "2", "COLDROUTE_MAX_SYNC_ROUTE_DAYS": "1000000"}
+    with running_server(env) as url:
+        for strategy in ("thermostat", "optimal"):
+            problem = fleet_problem(routes, days, strategy)
+            size = f"{routes} × {days} × {len(problem.candidates)}"
+            started = time.perf_counter()
+            result = study(problem)
+            wall_s = time.perf_counter() - started
+            simulated = result.route_days * len(problem.candidates)
+            fleet = " / ".join(str(f.routes_all_year) for f in result.fleet)
+            rows.append(_row(f"{strategy}, one process", size, wall_s, simulated, fleet))
+            started = time.perf_counter()
+            answer = _over_http(url, problem)
+            wall_s = time.perf_counter() - started
+            served = " / ".join(str(f["routes_all_year"]) for f in answer["fleet"])
+            rows.append(_row(f"{strategy}, HTTP, 2 workers", size, wall_s, simulated, served))
+        # the issue's size, whole: every day of 2026, over HTTP
+        problem = fleet_problem(routes, 365, "thermostat")
         started = time.perf_counter()
-        result = study(problem)
+        answer = _over_http(url, problem)
         wall_s = time.perf_counter() - started
-        simulated = result.route_days * len(problem.candidates)
-        per_s = simulated / wall_s
-        full = 50 * 365 * len(BATTERIES_KWH)
-        distances = [r.distance_km for r in result.routes]
-        rows.append(
-            [
-                strategy,
-                f"{routes} × {days} × {len(problem.candidates)}",
-                f"{min(distances):.0f}–{max(distances):.0f}",
-                f"{wall_s:.1f}",
-                f"{per_s:.0f}",
-                f"{full / per_s:,.0f}",
-                " / ".join(str(f.routes_all_year) for f in result.fleet),
-            ]
-        )
+        simulated = answer["route_days"] * len(problem.candidates)
+        served = " / ".join(str(f["routes_all_year"]) for f in answer["fleet"])
+        size = f"{routes} × 365 × {len(problem.candidates)}"
+        rows.append(_row("thermostat, HTTP, 2 workers", size, wall_s, simulated, served))
     print_table(
-        "Electrification study (core entry point of POST /v1/studies/electrification, one "
-        "process): route-days × candidates per second, and the time 50 × 365 × 3 would take",
+        "Electrification study: the core entry point in one process, and POST "
+        "/v1/studies/electrification on a server of 2 workers (the routes shared out) — "
+        "route-days × candidates per second, and the time 50 × 365 × 3 would take",
         [
-            "refrigeration",
+            "refrigeration, path",
             "routes × days × batteries",
-            "km per day",
             "wall [s]",
             "simulated per s",
             "50 × 365 × 3 [s]",

@@ -9,7 +9,15 @@ from app.schemas.studies import ElectrificationRequest, ElectrificationResponse
 from app.settings import Settings
 from core.exceptions import CoreError, ServerLimitError, TooMuchToWaitForError
 from core.planning.electrification.model import Candidate, ElectrificationProblem
-from core.planning.electrification.study import check_study, route_days, study
+from core.planning.electrification.study import (
+    StudyPart,
+    check_study,
+    merged,
+    parts_of,
+    route_days,
+    study,
+    study_part,
+)
 
 
 def electrification_problem(
@@ -70,3 +78,27 @@ def run_electrification_job(
 ) -> ElectrificationResponse:
     """The study as a job: a job's limit on route-days."""
     return run_electrification(request, settings, job=True)
+
+
+def study_parts(request: ElectrificationRequest, settings: Settings) -> list[range]:
+    """The synchronous study checked and split into a part per worker (routes of about as
+    many route-days each)."""
+    problem = electrification_problem(request, settings)
+    check_study(problem)
+    return parts_of(problem, settings.workers)
+
+
+def run_study_part(
+    request: ElectrificationRequest, settings: Settings, indices: range
+) -> StudyPart:
+    """The routes at ``indices`` simulated, in a worker."""
+    problem = electrification_problem(request, settings)
+    return study_part(problem, indices, connectors.router(settings))
+
+
+def merged_answer(
+    request: ElectrificationRequest, settings: Settings, parts: list[StudyPart], runtime_s: float
+) -> ElectrificationResponse:
+    """The answer of the parts, the same whatever the split."""
+    result = merged(electrification_problem(request, settings), parts, runtime_s)
+    return ElectrificationResponse(**dict(result))

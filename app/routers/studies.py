@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import asyncio
+import time
 from typing import Annotated
 
 from fastapi import APIRouter, Body, Request
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import ELECTRIFICATION_EXAMPLE, SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
-from app.operations.electrification import run_electrification as electrification
+from app.operations.electrification import merged_answer, run_study_part, study_parts
 from app.operations.studies import run_scenarios as scenarios
 from app.operations.studies import sweep_speeds as sweep
 from app.schemas.studies import (
@@ -92,5 +94,15 @@ async def study_electrification(
     each candidate van on every day it is driven in the year, with that date's weather: the
     days each battery covers (alone, and with the charges a day may take), the battery that
     covers 95 % and all of them, the worst days and why; per candidate, the routes that go
-    electric and the depot's recharge. Larger studies run as jobs (type electrification)."""
-    return await pool.run(electrification, request, settings, disconnected=http.is_disconnected)
+    electric and the depot's recharge. The routes are shared out over the server's workers.
+    Larger studies run as jobs (type electrification)."""
+    started = time.perf_counter()
+    parts = await pool.run(study_parts, request, settings, disconnected=http.is_disconnected)
+    done = await asyncio.gather(
+        *(
+            pool.run(run_study_part, request, settings, indices, disconnected=http.is_disconnected)
+            for indices in parts
+        )
+    )
+    runtime_s = time.perf_counter() - started
+    return await asyncio.to_thread(merged_answer, request, settings, list(done), runtime_s)

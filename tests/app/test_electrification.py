@@ -122,6 +122,13 @@ def _with(change) -> dict:
         (lambda b: b.update(year=1800), "year"),
         (lambda b: b.update(timezone="Mars/Olympus"), "timezone"),
         (lambda b: b.update(routes=[]), "routes"),
+        (
+            lambda b: (
+                b.update(refrigeration={"strategy": "optimal"}),
+                [c.pop("cargo_box") for c in b["candidates"]],
+            ),
+            "routes[0].product",
+        ),
     ],
 )
 def test_bad_studies_name_the_field(change, field):
@@ -151,3 +158,19 @@ def test_every_day_is_listed_when_asked_and_agrees_with_the_summary():
         for r in app_client().post(PATH, json=ELECTRIFICATION_EXAMPLE).json()["routes"]
         for c in r["candidates"]
     )
+
+
+def test_the_studys_strategy_runs_with_each_routes_goods():
+    """Candidates without goods in their box, routes that name theirs: the optimal strategy
+    the study gives every candidate keeps each route's goods in band."""
+    body = _with(
+        lambda b: (
+            b.update(refrigeration={"strategy": "optimal"}),
+            [c.pop("cargo_box") for c in b["candidates"]],
+            [r.update(product="chilled-dairy", days=["2026-07-15"]) for r in b["routes"]],
+        )
+    )
+    response = app_client().post(PATH, json=body)
+    assert response.status_code == 200, response.text
+    for route in response.json()["routes"]:
+        assert all(c["cold_chain_days_broken"] == 0 for c in route["candidates"])

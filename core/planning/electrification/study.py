@@ -15,6 +15,9 @@ from __future__ import annotations
 import datetime as dt
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from pydantic import ValidationError
 
 from core.clock import departure
 from core.exceptions import CoreError, InvalidParameterError
@@ -30,14 +33,23 @@ from core.planning.electrification.model import (
     DrivenRoute,
     ElectrificationProblem,
     ElectrificationResult,
+    RouteOutcome,
     Weekdays,
 )
-from core.planning.electrification.summary import DayOutcome, fleet_outcome, route_outcome
+from core.planning.electrification.summary import (
+    DayOutcome,
+    DepotRecharge,
+    fleet_outcome,
+    route_outcome,
+)
 from core.planning.itinerary import Itinerary
 from core.planning.model import PlanProblem
 from core.planning.round.planner import check
 from core.planning.search.day import leg_roads
 from core.routing.roads import RoadRouter
+
+#: A route is driven once a day: its day lasts at most this [s].
+DAY_S = 86_400.0
 
 
 def route_dates(route: DrivenRoute, year: int, field: str) -> list[dt.date]:
@@ -93,6 +105,20 @@ def check_study(problem: ElectrificationProblem) -> None:
                 raise type(error)(said, error.field).under(f"routes[{i}]") from None
 
 
+@dataclass(frozen=True)
+class StudyPart:
+    """Some of a study's routes simulated: their outcomes in order, the depot's recharge of
+    each one's days, their route-days and how long they took [s]. Parts of one study merge
+    into its answer (:func:`merged`) whatever process each ran in, the same figures however
+    the routes were split (the recharges are added route by route, in order)."""
+
+    first: int
+    routes: list[RouteOutcome]
+    depot: list[DepotRecharge]
+    route_days: int
+    runtime_s: float
+
+
 def study(
     problem: ElectrificationProblem,
     router: RoadRouter | None = None,
@@ -103,12 +129,25 @@ def study(
     the route-days done after each route."""
     started = time.perf_counter()
     check_study(problem)
+    part = study_part(problem, range(len(problem.routes)), router, progress)
+    return merged(problem, [part], time.perf_counter() - started)
+
+
+def study_part(
+    problem: ElectrificationProblem,
+    indices: range,
+    router: RoadRouter | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> StudyPart:
+    """The routes at ``indices`` of a checked study (:func:`check_study`) simulated."""
+    started = time.perf_counter()
     outcomes = []
     years: list[dict[str, list[DayOutcome]]] = []
-    for i, route in enumerate(problem.routes):
+    vans = {c.id: c.van for c in problem.candidates}
+    for i in indices:
+        route = problem.routes[i]
         dates = route_dates(route, problem.year, f"routes[{i}].days")
         try:
-            vans = {c.id: c.van for c in problem.candidates}
             year = route_year(problem, route, vans, dates, router)
         except CoreError as error:
             raise error.under(f"routes[{i}]") from None
@@ -116,14 +155,30 @@ def study(
         outcomes.append(route_outcome(route.id, year, problem.chargers, problem.include_days))
         if progress is not None:
             progress(len(dates))
-    runtime_s = time.perf_counter() - started
-    count = sum(len(next(iter(year.values()))) for year in years)
+    return StudyPart(
+        first=indices.start,
+        routes=outcomes,
+        depot=[DepotRecharge.of(year) for year in years],
+        route_days=sum(len(next(iter(year.values()))) for year in years),
+        runtime_s=time.perf_counter() - started,
+    )
+
+
+def merged(
+    problem: ElectrificationProblem, parts: Sequence[StudyPart], runtime_s: float
+) -> ElectrificationResult:
+    """The study's answer from its ``parts`` (together its routes, each once), which took
+    ``runtime_s`` in all [s]."""
+    ordered = sorted(parts, key=lambda part: part.first)
+    outcomes = [route for part in ordered for route in part.routes]
+    depot = DepotRecharge({}, {})
+    for part in ordered:
+        for route_depot in part.depot:
+            depot = depot.plus(route_depot)
+    count = sum(part.route_days for part in parts)
     return ElectrificationResult(
         routes=outcomes,
-        fleet=[
-            fleet_outcome(c.id, outcomes, [year[c.id] for year in years], problem.chargers)
-            for c in problem.candidates
-        ],
+        fleet=[fleet_outcome(c.id, outcomes, depot, problem.chargers) for c in problem.candidates],
         route_days=count,
         route_days_per_s=count * len(problem.candidates) / max(runtime_s, 1e-9),
         runtime_s=runtime_s,
@@ -131,16 +186,38 @@ def study(
     )
 
 
+def parts_of(problem: ElectrificationProblem, count: int) -> list[range]:
+    """The routes in at most ``count`` consecutive ranges of about as many route-days each."""
+    days = [
+        len(route_dates(r, problem.year, f"routes[{i}].days")) for i, r in enumerate(problem.routes)
+    ]
+    ranges: list[range] = []
+    total, first, done = sum(days), 0, 0
+    for i, n in enumerate(days):
+        done += n
+        if done >= total * (len(ranges) + 1) / count or i == len(days) - 1:
+            ranges.append(range(first, i + 1))
+            first = i + 1
+    return ranges
+
+
 def carrying(van: VanParams, route: DrivenRoute) -> VanParams:
-    """``van`` with the route's goods in its box (:attr:`DrivenRoute.product`)."""
-    if route.product is None:
-        return van
-    box, band = van.cargo_box, product_band(route.product)
-    inside = band.min_c <= box.setpoint_c <= band.max_c
-    changes = {"product": route.product, "setpoint_c": box.setpoint_c if inside else band.middle_c}
-    # the set-point is inside the band: the box's checks hold as they did
-    carried = type(box).model_validate(box.model_dump() | changes)
-    return van.model_copy(update={"cargo_box": carried})
+    """``van`` with the route's goods in its box (:attr:`DrivenRoute.product`), checked whole:
+    a strategy the study gave every candidate (``refrigeration``) may need the goods; without
+    them it is an error naming the route's product."""
+    box = van.cargo_box
+    if route.product is not None:
+        band = product_band(route.product)
+        inside = band.min_c <= box.setpoint_c <= band.max_c
+        setpoint_c = box.setpoint_c if inside else band.middle_c
+        box = box.model_copy(update={"product": route.product, "setpoint_c": setpoint_c})
+    try:
+        return VanParams.model_validate(van.model_dump() | {"cargo_box": box.model_dump()})
+    except ValidationError as error:
+        rule = error.errors()[0]["msg"].removeprefix("Value error, ")
+        raise InvalidParameterError(
+            f"{rule}: give the route its product, or the candidate's box its goods", "product"
+        ) from None
 
 
 def _round(
@@ -177,6 +254,12 @@ def route_year(
     for ids in kinds.values():
         first = _round(problem, route, vans[ids[0]], dates[0])
         timeline = _laid_out(first, router)
+        if timeline.duration_s > DAY_S:  # it could not be driven again the next day
+            raise InvalidParameterError(
+                f"the route's day lasts {timeline.duration_s / 3600:.1f} h (its drives, stops "
+                "and breaks in the order given): longer than a day",
+                "stops",
+            )
         for date in dates:
             start, _ = departure(date, route.start_time, problem.timezone, route.depot.lon)
             result = simulate(

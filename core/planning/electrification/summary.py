@@ -5,7 +5,6 @@ covers 95 % and all of them, the worst days and what made them worst; per candid
 from __future__ import annotations
 
 import datetime as dt
-from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -159,26 +158,54 @@ def worst_days(days: Sequence[DayOutcome]) -> list[WorstDay]:
     return out
 
 
+ByDate = dict[str, dict[dt.date, float]]
+
+
+@dataclass(frozen=True)
+class DepotRecharge:
+    """What the depot recharges on each date [kWh], and at what power [kW], by candidate:
+    each van back to full from the grid (:attr:`BatteryVerdict.recharge_kwh`), evenly while
+    parked until the same time the next day, on the days it covers on one charge (it drives
+    no other electric). Parts of a study add up (:meth:`plus`)."""
+
+    kwh: ByDate
+    kw: ByDate
+
+    @classmethod
+    def of(cls, year: dict[str, list[DayOutcome]]) -> DepotRecharge:
+        """The depot's recharge of one route's ``year`` (by candidate id)."""
+        kwh: ByDate = {}
+        kw: ByDate = {}
+        for candidate_id, days in year.items():
+            kwh[candidate_id], kw[candidate_id] = {}, {}
+            for day in days:
+                if not day.battery.feasible:
+                    continue
+                parked_h = max((86_400.0 - day.duration_s) / 3600.0, MIN_PARKED_H)
+                kwh[candidate_id][day.date] = day.battery.recharge_kwh
+                kw[candidate_id][day.date] = day.battery.recharge_kwh / parked_h
+        return cls(kwh, kw)
+
+    def plus(self, other: DepotRecharge) -> DepotRecharge:
+        def added(a: ByDate, b: ByDate) -> ByDate:
+            out = {k: dict(v) for k, v in a.items()}
+            for candidate_id, dates in b.items():
+                mine = out.setdefault(candidate_id, {})
+                for date, value in dates.items():
+                    mine[date] = mine.get(date, 0.0) + value
+            return out
+
+        return DepotRecharge(added(self.kwh, other.kwh), added(self.kw, other.kw))
+
+
 def fleet_outcome(
     candidate_id: str,
     routes: Sequence[RouteOutcome],
-    years: Sequence[Sequence[DayOutcome]],
+    depot: DepotRecharge,
     chargers: Sequence[ChargeOption],
 ) -> FleetOutcome:
-    """One candidate across the fleet: ``routes`` summed up, and ``years`` (its days on each
-    route) for the depot's recharge on each date — each van back to full from the grid
-    (:attr:`BatteryVerdict.recharge_kwh`), evenly while parked until the same time the next
-    day; the days it covers on one charge (it drives no other electric)."""
+    """One candidate across the fleet: ``routes`` summed up, and the ``depot``'s recharge."""
     mine = [next(c for c in r.candidates if c.id == candidate_id) for r in routes]
-    energy: dict[dt.date, float] = defaultdict(float)
-    power: dict[dt.date, float] = defaultdict(float)
-    for days in years:
-        for day in days:
-            if not day.battery.feasible:  # a day the van cannot drive is not driven electric
-                continue
-            parked_h = max((86_400.0 - day.duration_s) / 3600.0, MIN_PARKED_H)
-            energy[day.date] += day.battery.recharge_kwh
-            power[day.date] += day.battery.recharge_kwh / parked_h
     return FleetOutcome(
         id=candidate_id,
         routes_all_year=sum(c.days_feasible == c.days_total for c in mine),
@@ -186,6 +213,6 @@ def fleet_outcome(
         routes_all_year_with_charging=None
         if not chargers
         else sum(c.days_feasible_with_charging == c.days_total for c in mine),
-        depot_kwh_max_day=max(energy.values(), default=0.0),
-        depot_kw_peak=max(power.values(), default=0.0),
+        depot_kwh_max_day=max(depot.kwh.get(candidate_id, {}).values(), default=0.0),
+        depot_kw_peak=max(depot.kw.get(candidate_id, {}).values(), default=0.0),
     )

@@ -21,9 +21,12 @@ from core.planning.electrification.model import (
 )
 from core.planning.electrification.study import (
     carrying,
+    merged,
+    parts_of,
     route_dates,
     route_year,
     study,
+    study_part,
     topped_up,
 )
 from core.planning.model import PlanProblem
@@ -262,3 +265,38 @@ def test_batteries_alone_apart_share_one_simulation_and_get_their_own_verdicts()
         (day,) = shared[name]
         assert day.battery == alone.battery
         assert day.energy_kwh == pytest.approx(alone.energy_kwh, rel=1e-12)
+
+
+def test_a_route_longer_than_a_day_is_named():
+    """120 stops of an hour each: more than 24 h in the order given."""
+    long = route(MONTHS[:1], 120).model_copy(
+        update={
+            "stops": [
+                s.model_copy(update={"service_time_s": 3600.0, "delivery_kg": 0.0})
+                for s in stops(120)
+            ]
+        }
+    )
+    with pytest.raises(CoreError) as caught:
+        study(problem(long, VAN))
+    assert caught.value.field == "routes[0].stops" and "longer than a day" in caught.value.message
+
+
+@pytest.mark.parametrize("count", [1, 2, 3, 5])
+def test_a_study_split_into_parts_answers_what_it_answers_whole(count):
+    """Routes of 1, 3 and 2 days in parts (in any process): the parts cover every route once,
+    in order, and merged they give the whole study's figures exactly (its clock aside)."""
+    routes = [
+        route(MONTHS[:1], 8, "a"),
+        route(MONTHS[3:6], 10, "b"),
+        route(MONTHS[6:8], 12, "c"),
+    ]
+    p = problem(routes[0], VAN, frozen_van()).model_copy(update={"routes": routes})
+    whole = study(p)
+    ranges = parts_of(p, count)
+    assert [i for r in ranges for i in r] == [0, 1, 2] and len(ranges) <= count
+    parts = [study_part(p, r) for r in reversed(ranges)]  # finished in any order
+    split = merged(p, parts, whole.runtime_s)
+    timing = {"runtime_s", "route_days_per_s"}
+    assert split.model_dump(exclude=timing) == whole.model_dump(exclude=timing)
+    assert split.route_days == 6
