@@ -11,12 +11,14 @@ from core.exceptions import CoreError, ServerLimitError, TooMuchToWaitForError
 from core.planning.electrification.model import Candidate, ElectrificationProblem
 from core.planning.electrification.study import (
     StudyPart,
+    Weather,
     check_study,
     merged,
     parts_of,
     route_days,
     study,
     study_part,
+    year_weather,
 )
 
 
@@ -42,6 +44,7 @@ def electrification_problem(
         candidates=candidates,
         chargers=request.chargers,
         include_days=request.include_days,
+        weather_source=request.weather.source,
     )
     simulated = route_days(problem) * len(candidates)
     said = f"{simulated:,} route-days × candidates"
@@ -68,8 +71,12 @@ def check_electrification(request: ElectrificationRequest, settings: Settings) -
 def run_electrification(
     request: ElectrificationRequest, settings: Settings, job: bool = False
 ) -> ElectrificationResponse:
-    """The study, with the configured road router."""
-    result = study(electrification_problem(request, settings, job), connectors.router(settings))
+    """The study, with the configured road router and weather service."""
+    result = study(
+        electrification_problem(request, settings, job),
+        connectors.router(settings),
+        connectors.weather_service(settings),
+    )
     return ElectrificationResponse(**dict(result))
 
 
@@ -80,25 +87,30 @@ def run_electrification_job(
     return run_electrification(request, settings, job=True)
 
 
-def study_parts(request: ElectrificationRequest, settings: Settings) -> list[range]:
-    """The synchronous study checked and split into a part per worker (routes of about as
-    many route-days each)."""
+def study_parts(request: ElectrificationRequest, settings: Settings) -> tuple[list[range], Weather]:
+    """The synchronous study checked, split into a part per worker (routes of about as many
+    route-days each), and the weather all parts run on (fetched once)."""
     problem = electrification_problem(request, settings)
     check_study(problem)
-    return parts_of(problem, settings.workers)
+    weather = year_weather(problem, connectors.weather_service(settings))
+    return parts_of(problem, settings.workers), weather
 
 
 def run_study_part(
-    request: ElectrificationRequest, settings: Settings, indices: range
+    request: ElectrificationRequest, settings: Settings, indices: range, weather: Weather
 ) -> StudyPart:
     """The routes at ``indices`` simulated, in a worker."""
     problem = electrification_problem(request, settings)
-    return study_part(problem, indices, connectors.router(settings))
+    return study_part(problem, indices, weather, connectors.router(settings))
 
 
 def merged_answer(
-    request: ElectrificationRequest, settings: Settings, parts: list[StudyPart], runtime_s: float
+    request: ElectrificationRequest,
+    settings: Settings,
+    parts: list[StudyPart],
+    weather: Weather,
+    runtime_s: float,
 ) -> ElectrificationResponse:
     """The answer of the parts, the same whatever the split."""
-    result = merged(electrification_problem(request, settings), parts, runtime_s)
+    result = merged(electrification_problem(request, settings), parts, weather, runtime_s)
     return ElectrificationResponse(**dict(result))

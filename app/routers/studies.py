@@ -97,12 +97,16 @@ async def study_electrification(
     electric and the depot's recharge. The routes are shared out over the server's workers.
     Larger studies run as jobs (type electrification)."""
     started = time.perf_counter()
-    parts = await pool.run(study_parts, request, settings, disconnected=http.is_disconnected)
+    parts, weather = await pool.run(
+        study_parts, request, settings, disconnected=http.is_disconnected
+    )
     done = await asyncio.gather(
         *(
-            pool.run(run_study_part, request, settings, indices, disconnected=http.is_disconnected)
-            for indices in parts
+            pool.run(
+                run_study_part, request, settings, part, weather, disconnected=http.is_disconnected
+            )
+            for part in parts
         )
     )
     runtime_s = time.perf_counter() - started
-    return await asyncio.to_thread(merged_answer, request, settings, list(done), runtime_s)
+    return await asyncio.to_thread(merged_answer, request, settings, list(done), weather, runtime_s)

@@ -131,10 +131,12 @@ class CandidateRequest(VanRequest):
 class StudyWeather(ApiModel):
     """Where each date's weather comes from."""
 
-    source: Literal["climatology"] = Field(
+    source: Literal["climatology", "archive"] = Field(
         "climatology",
         description="climatology: the typical day of each date at the place (the depot's, or "
-        "location).",
+        "location); archive: the configured weather service's hours of the year "
+        "(COLDROUTE_WEATHER_URL / COLDROUTE_WEATHER_ARCHIVE_URL; the climatology, said in "
+        "the answer's warnings, where none is configured or it fails).",
     )
 
 

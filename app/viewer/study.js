@@ -75,7 +75,8 @@ function drawCandidate(candidateId) {
   $("study-fleet").textContent = `${candidateId}: ${fleet.routes_all_year} of ${routes.length} ` +
     `route(s) all year on one charge, ${fleet.routes_p95} on 95 % of days` +
     (fleet.routes_all_year_with_charging === null ? "" : `, ${fleet.routes_all_year_with_charging} all year with the charges`) +
-    `; the depot recharges at most ${fleet.depot_kwh_max_day.toFixed(1)} kWh a day.`;
+    `; the depot recharges at most ${fleet.depot_kwh_max_day.toFixed(1)} kWh a day. ` +
+    `Weather: ${study.answer.weather_source}${study.answer.warnings.length ? ` (${study.answer.warnings.join("; ")})` : ""}.`;
   drawHeatMap(routes, candidateId);
   drawCoverage(routes, candidateId);
 }

@@ -118,7 +118,7 @@ def _with(change) -> dict:
         ),
         (lambda b: b["chargers"][0].update(power_kw=0), "chargers[0].power_kw"),
         (lambda b: b["chargers"][0].update(where="roof"), "chargers[0].where"),
-        (lambda b: b.update(weather={"source": "archive"}), "weather.source"),
+        (lambda b: b.update(weather={"source": "radar"}), "weather.source"),
         (lambda b: b.update(year=1800), "year"),
         (lambda b: b.update(timezone="Mars/Olympus"), "timezone"),
         (lambda b: b.update(routes=[]), "routes"),
@@ -174,3 +174,40 @@ def test_the_studys_strategy_runs_with_each_routes_goods():
     assert response.status_code == 200, response.text
     for route in response.json()["routes"]:
         assert all(c["cold_chain_days_broken"] == 0 for c in route["candidates"])
+
+
+def _archived(body: dict) -> dict:
+    """The example in 2025 (archived: a year gone), on its first days, from the archive."""
+    return body | {
+        "year": 2025,
+        "weather": {"source": "archive"},
+        "routes": [r | {"days": ["2025-01-14", "2025-07-15"]} for r in body["routes"]],
+    }
+
+
+def test_a_year_from_the_weather_archive(weather_stub):
+    """The stub's archive is 33 °C every hour: the winter day needs as much refrigeration as
+    the summer one and more than the climatology's January; one request per place."""
+    weather_stub.requests.clear()
+    hot = app_client(weather_url=f"{weather_stub.url}/hot")
+    body = _archived(ELECTRIFICATION_EXAMPLE) | {"include_days": True}
+    archived = hot.post(PATH, json=body).json()
+    assert archived["weather_source"] == "archive" and archived["warnings"] == []
+    climate = app_client().post(PATH, json=body).json()
+    assert climate["weather_source"] == "climatology"
+    assert "no weather service is configured" in climate["warnings"][0]
+    for served, typical in zip(archived["routes"], climate["routes"], strict=True):
+        winter, summer = served["candidates"][0]["days"]
+        assert winter["energy_kwh"] == pytest.approx(summer["energy_kwh"], rel=0.05)
+        unit = [r["candidates"][0]["energy_kwh_mean"]["refrigeration"] for r in (served, typical)]
+        assert unit[0] > unit[1]  # 33 °C in January too: the frozen box's unit works harder
+    places = {(q["latitude"], q["longitude"]) for _, q in weather_stub.requests}
+    assert len(places) == 2  # the two depots, each asked once for the whole year
+    assert all(path.endswith("/v1/archive") for path, _ in weather_stub.requests)
+
+
+def test_an_archive_that_fails_falls_back_to_the_climatology_and_says_so(weather_stub):
+    failing = app_client(weather_url=f"{weather_stub.url}/error")
+    answer = failing.post(PATH, json=_archived(ELECTRIFICATION_EXAMPLE)).json()
+    assert answer["weather_source"] == "climatology"
+    assert "weather archive is unavailable" in answer["warnings"][0]

@@ -23,6 +23,7 @@ from core.params import (
 
 Weekday = Literal["mon", "tue", "wed", "thu", "fri", "sat", "sun"]
 WEEKDAYS: tuple[Weekday, ...] = ("mon", "tue", "wed", "thu", "fri", "sat", "sun")
+WeatherSourceName = Literal["climatology", "archive"]
 #: Most routes, candidates, stops of a route and days of a route a study takes (the server's
 #: limit on route-days, ``COLDROUTE_MAX_ROUTE_DAYS``, is its own).
 MAX_ROUTES = 1000
@@ -128,6 +129,12 @@ class ElectrificationProblem(Params):
     )
     include_days: bool = Field(
         False, description="Every route-day's figures in the answer (days[] per candidate)."
+    )
+    weather_source: WeatherSourceName = Field(
+        "climatology",
+        description="climatology: each date's typical day at the place; archive: the weather "
+        "service's hourly archive of the year (the climatology, said in the answer, where "
+        "none is configured or it fails).",
     )
 
 
@@ -246,8 +253,11 @@ class ElectrificationResult(Result):
         ..., description="Route-days × candidates simulated per second of the study."
     )
     runtime_s: float = Field(..., description="How long the study took [s].")
-    weather_source: Literal["climatology"] = Field(
+    weather_source: WeatherSourceName = Field(
         ...,
-        description="Where each date's weather came from: climatology, the depot's place's "
-        "typical day of that date.",
+        description="Where each date's weather came from: climatology (the place's typical "
+        "day of that date) or archive (the weather service's hours of the year).",
+    )
+    warnings: list[str] = Field(
+        default_factory=list, description="What the answer must say of itself (the weather)."
     )

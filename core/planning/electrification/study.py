@@ -20,11 +20,12 @@ from dataclasses import dataclass
 from pydantic import ValidationError
 
 from core.clock import departure
-from core.exceptions import CoreError, InvalidParameterError
+from core.exceptions import CoreError, InvalidParameterError, ServiceUnavailableError
 from core.params import Location, VanParams, product_band
 from core.physics.battery import BatteryVerdict
 from core.physics.cold_chain import check_cold_chain
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
+from core.physics.weather import HourlyWeather, WeatherService
 from core.planning.day.scene import legs_for, round_places
 from core.planning.day.timeline import PLAN_DT_S, Timeline, build_timeline, rest_after
 from core.planning.electrification.model import (
@@ -34,6 +35,7 @@ from core.planning.electrification.model import (
     ElectrificationProblem,
     ElectrificationResult,
     RouteOutcome,
+    WeatherSourceName,
     Weekdays,
 )
 from core.planning.electrification.summary import (
@@ -105,6 +107,46 @@ def check_study(problem: ElectrificationProblem) -> None:
                 raise type(error)(said, error.field).under(f"routes[{i}]") from None
 
 
+#: A place's weather for the year: by (lat, lon), the service's hours (None: climatology).
+YearWeather = dict[tuple[float, float], HourlyWeather]
+
+
+@dataclass(frozen=True)
+class Weather:
+    """The weather a study runs on: the archive's hours of the year at each place, or none
+    (each date's climatology); where it came from, and what the answer must say of it."""
+
+    hours: YearWeather
+    source: WeatherSourceName
+    warnings: list[str]
+
+
+def year_weather(problem: ElectrificationProblem, service: WeatherService | None) -> Weather:
+    """The year's hourly archive at each place of the study (``location``, or each depot),
+    fetched once, when the study asks for the archive and a service is configured; else, or
+    when it fails, the climatology and a warning that says so."""
+    if problem.weather_source == "climatology":
+        return Weather({}, "climatology", [])
+    if service is None:
+        said = "no weather service is configured (COLDROUTE_WEATHER_URL)"
+        return Weather({}, "climatology", [f"{said}: used each date's climatology"])
+    first = dt.datetime(problem.year, 1, 1, tzinfo=dt.UTC) - dt.timedelta(days=1)
+    last = dt.datetime(problem.year, 12, 31, tzinfo=dt.UTC) + dt.timedelta(days=2)
+    hours: YearWeather = {}
+    for place in {_place(problem, route) for route in problem.routes}:
+        try:
+            hours[place] = service.hourly(place[0], place[1], first, last)
+        except ServiceUnavailableError as error:
+            said = f"the weather archive is unavailable ({error.message})"
+            return Weather({}, "climatology", [f"{said}: used each date's climatology"])
+    return Weather(hours, "archive", [])
+
+
+def _place(problem: ElectrificationProblem, route: DrivenRoute) -> tuple[float, float]:
+    where = problem.location or route.depot
+    return (where.lat, where.lon)
+
+
 @dataclass(frozen=True)
 class StudyPart:
     """Some of a study's routes simulated: their outcomes in order, the depot's recharge of
@@ -122,24 +164,28 @@ class StudyPart:
 def study(
     problem: ElectrificationProblem,
     router: RoadRouter | None = None,
+    weather_service: WeatherService | None = None,
     progress: Callable[[int], None] | None = None,
 ) -> ElectrificationResult:
     """Simulate every route on each of its days for each candidate and sum it up per route
-    and per candidate (:mod:`core.planning.electrification.summary`). ``progress`` is told
-    the route-days done after each route."""
+    and per candidate (:mod:`core.planning.electrification.summary`), on the weather
+    :func:`year_weather` gives. ``progress`` is told the route-days done after each route."""
     started = time.perf_counter()
     check_study(problem)
-    part = study_part(problem, range(len(problem.routes)), router, progress)
-    return merged(problem, [part], time.perf_counter() - started)
+    weather = year_weather(problem, weather_service)
+    part = study_part(problem, range(len(problem.routes)), weather, router, progress)
+    return merged(problem, [part], weather, time.perf_counter() - started)
 
 
 def study_part(
     problem: ElectrificationProblem,
     indices: range,
+    weather: Weather,
     router: RoadRouter | None = None,
     progress: Callable[[int], None] | None = None,
 ) -> StudyPart:
-    """The routes at ``indices`` of a checked study (:func:`check_study`) simulated."""
+    """The routes at ``indices`` of a checked study (:func:`check_study`) simulated on
+    ``weather``."""
     started = time.perf_counter()
     outcomes = []
     years: list[dict[str, list[DayOutcome]]] = []
@@ -148,7 +194,8 @@ def study_part(
         route = problem.routes[i]
         dates = route_dates(route, problem.year, f"routes[{i}].days")
         try:
-            year = route_year(problem, route, vans, dates, router)
+            hours = weather.hours.get(_place(problem, route))
+            year = route_year(problem, route, vans, dates, router, hours)
         except CoreError as error:
             raise error.under(f"routes[{i}]") from None
         years.append(year)
@@ -165,10 +212,13 @@ def study_part(
 
 
 def merged(
-    problem: ElectrificationProblem, parts: Sequence[StudyPart], runtime_s: float
+    problem: ElectrificationProblem,
+    parts: Sequence[StudyPart],
+    weather: Weather,
+    runtime_s: float,
 ) -> ElectrificationResult:
-    """The study's answer from its ``parts`` (together its routes, each once), which took
-    ``runtime_s`` in all [s]."""
+    """The study's answer from its ``parts`` (together its routes, each once, on
+    ``weather``), which took ``runtime_s`` in all [s]."""
     ordered = sorted(parts, key=lambda part: part.first)
     outcomes = [route for part in ordered for route in part.routes]
     depot = DepotRecharge({}, {})
@@ -182,7 +232,8 @@ def merged(
         route_days=count,
         route_days_per_s=count * len(problem.candidates) / max(runtime_s, 1e-9),
         runtime_s=runtime_s,
-        weather_source="climatology",
+        weather_source=weather.source,
+        warnings=weather.warnings,
     )
 
 
@@ -241,10 +292,12 @@ def route_year(
     vans: dict[str, VanParams],
     dates: Sequence[dt.date],
     router: RoadRouter | None = None,
+    hours: HourlyWeather | None = None,
 ) -> dict[str, list[DayOutcome]]:
     """The route laid out once for each kind of van among ``vans`` (by candidate id) and
-    simulated on each of ``dates``; vans that differ in their battery alone share the
-    simulation (:func:`core.physics.simulate.with_battery`)."""
+    simulated on each of ``dates`` with the ``hours`` of the year (None: each date's
+    climatology); vans that differ in their battery alone share the simulation
+    (:func:`core.physics.simulate.with_battery`)."""
     kinds: dict[str, list[str]] = {}
     for candidate_id, van in vans.items():
         key = carrying(van, route).model_dump_json(exclude={"battery"})
@@ -268,6 +321,7 @@ def route_year(
                 start,
                 location,
                 first.van,
+                weather=hours,
                 grade=timeline.grade,
                 payload_kg=timeline.payload,
                 door_openings=timeline.doors,

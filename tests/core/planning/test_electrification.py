@@ -28,6 +28,7 @@ from core.planning.electrification.study import (
     study,
     study_part,
     topped_up,
+    year_weather,
 )
 from core.planning.model import PlanProblem
 from core.planning.round.planner import plan
@@ -295,8 +296,9 @@ def test_a_study_split_into_parts_answers_what_it_answers_whole(count):
     whole = study(p)
     ranges = parts_of(p, count)
     assert [i for r in ranges for i in r] == [0, 1, 2] and len(ranges) <= count
-    parts = [study_part(p, r) for r in reversed(ranges)]  # finished in any order
-    split = merged(p, parts, whole.runtime_s)
+    weather = year_weather(p, None)
+    parts = [study_part(p, r, weather) for r in reversed(ranges)]  # finished in any order
+    split = merged(p, parts, weather, whole.runtime_s)
     timing = {"runtime_s", "route_days_per_s"}
     assert split.model_dump(exclude=timing) == whole.model_dump(exclude=timing)
     assert split.route_days == 6
