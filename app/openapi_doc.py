@@ -38,6 +38,7 @@ ERRORS: dict[str, tuple[int, ...]] = {
     "sweepSpeeds": (401, 413, 422, 503),
     "runScenarios": (401, 413, 422, 503),
     "studyElectrification": (401, 413, 422, 503),
+    "electrificationStudyFromCsv": (401, 413, 422),
     "createCalibration": (401, 413, 422, 503),
     "createCalibrationFromCsv": (401, 413, 422, 503),
     "listPresets": (401,),

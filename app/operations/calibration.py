@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import csv
-import math
-import re
 import uuid
 from typing import Any
 
 import numpy as np
 
+from app.operations.cells import delimiter_of, number
 from app.operations.vans import van_of
 from app.profiles import profile_store
 from app.schemas.calibration import (
@@ -132,7 +131,7 @@ def csv_columns(text: str, field: str) -> dict[str, list[float]]:
     lines = text.lstrip("\ufeff").splitlines()
     if not lines or not lines[0].strip():
         raise InvalidParameterError("the CSV has no header row", field)
-    delimiter = ";" if lines[0].count(";") > lines[0].count(",") else ","
+    delimiter = delimiter_of(lines[0])
     rows = list(csv.reader(lines, delimiter=delimiter))
     header = [cell.strip() for cell in rows[0]]
     for name in header:
@@ -151,34 +150,8 @@ def csv_columns(text: str, field: str) -> dict[str, list[float]]:
                 f"{field}.{header[0]}[{index}]",
             )
         for name, cell in zip(header, row, strict=True):
-            columns[name].append(_number(cell, delimiter, f"{field}.{name}[{index}]"))
+            columns[name].append(number(cell, delimiter, f"{field}.{name}[{index}]"))
     return columns
-
-
-#: A number as a spreadsheet writes one: ASCII digits, one point, an exponent. Python's
-#: float() also reads ``1_0`` and other scripts' digits (``١٠``) as 10: not a telematics cell.
-_CSV_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
-
-
-def _infinite(text: str) -> float:
-    """``inf`` or ``nan`` as float() reads them (refused as not finite), else ValueError."""
-    value = float(text)
-    if math.isfinite(value):
-        raise ValueError(text)
-    return value
-
-
-def _number(cell: str, delimiter: str, field: str) -> float:
-    text = cell.strip()
-    if delimiter == ";":
-        text = text.replace(",", ".")
-    try:
-        value = float(text) if _CSV_NUMBER.fullmatch(text) else _infinite(text)
-    except ValueError:
-        raise InvalidParameterError(f"{cell[:40]!r} is not a number", field) from None
-    if not math.isfinite(value):
-        raise InvalidParameterError(f"{cell[:40]!r} is not a finite number", field)
-    return value
 
 
 def with_csv_trips(body: dict[str, Any], files: dict[str, str]) -> dict[str, Any]:

@@ -3,16 +3,21 @@
 from __future__ import annotations
 
 import asyncio
+import json
 import time
-from typing import Annotated
+from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Request
+from fastapi import APIRouter, Body, File, Form, Request, UploadFile
+from fastapi.exceptions import RequestValidationError
+from pydantic import ValidationError
+from starlette.concurrency import run_in_threadpool
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import ELECTRIFICATION_EXAMPLE, SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
 from app.operations.electrification import merged_answer, run_study_part, study_parts
 from app.operations.studies import run_scenarios as scenarios
 from app.operations.studies import sweep_speeds as sweep
+from app.operations.telematics import with_history
 from app.schemas.studies import (
     ElectrificationRequest,
     ElectrificationResponse,
@@ -21,6 +26,7 @@ from app.schemas.studies import (
     SpeedSweepRequest,
     SpeedSweepResponse,
 )
+from core.exceptions import InvalidParameterError
 
 router = APIRouter(prefix="/studies", tags=["studies"])
 
@@ -110,3 +116,51 @@ async def study_electrification(
     )
     runtime_s = time.perf_counter() - started
     return await asyncio.to_thread(merged_answer, request, settings, list(done), weather, runtime_s)
+
+
+@router.post(
+    "/electrification/from-csv",
+    operation_id="electrificationStudyFromCsv",
+    summary="A study's routes from a telematics export (CSV)",
+    response_model_exclude_unset=True,  # the study as sent, ready to send on
+)
+async def electrification_study_from_csv(
+    study: Annotated[
+        str,
+        Form(
+            description="The body of POST /v1/studies/electrification as JSON text, its routes "
+            "without stops, start_time and days: `id`, `depot`, `product`."
+        ),
+    ],
+    history: Annotated[
+        UploadFile,
+        File(
+            description="The telematics export: a header row, then one row per stop visited — "
+            "`route_id`, `date` (YYYY-MM-DD), `stop_id`, `lat`, `lon`, `arrival`, `departure` "
+            "(local HH:MM or HH:MM:SS) and optionally `delivery_kg`, `door_minutes`; each day "
+            "of a route its rows together, first the departure from the route's depot (its "
+            "`stop_id` the depot's id), then the stops in the order driven, then the return if "
+            "the export has it. Comma or semicolon between cells. UTF-8."
+        ),
+    ],
+) -> ElectrificationRequest:
+    """The study with each route's days as driven, read from the export (a bad cell is a 422
+    naming `history[<line>].<column>`, the file's line): send it to POST
+    /v1/studies/electrification, or as a job of type electrification when it is large."""
+    try:
+        body: Any = json.loads(study)
+    except ValueError as error:
+        raise InvalidParameterError(f"not JSON ({error})", "study") from None
+    if not isinstance(body, dict):
+        raise InvalidParameterError("not a JSON object", "study")
+    try:
+        text = (await history.read()).decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise InvalidParameterError("the file is not UTF-8 text", "history") from None
+    merged = await run_in_threadpool(with_history, body, text)
+    try:
+        return ElectrificationRequest.model_validate(merged)
+    except ValidationError as error:
+        raise RequestValidationError(
+            [e | {"loc": ("body", *e["loc"])} for e in error.errors()], body=merged
+        ) from None

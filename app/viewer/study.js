@@ -16,6 +16,32 @@ async function loadStudyExample() {
 
 function studyStatus(text) { $("study-status").textContent = text; }
 
+async function readExport() {
+  // A telematics export (one row per stop) made into the study's days by the service; the
+  // study's other fields from the request above (its routes: id, depot, product).
+  const file = $("study-csv").files[0];
+  if (!file) return;
+  let study;
+  try { study = JSON.parse($("study-json").value); } catch (error) {
+    studyStatus(`The study request is not JSON: ${error.message}`);
+    return;
+  }
+  for (const route of study.routes || []) {
+    delete route.stops; delete route.start_time; delete route.days;
+  }
+  const form = new FormData();
+  form.append("study", JSON.stringify(study));
+  form.append("history", file);
+  const headers = { Accept: "application/json" };
+  if ($("api-key").value) headers["X-API-Key"] = $("api-key").value;
+  const response = await fetch("/v1/studies/electrification/from-csv", { method: "POST", headers, body: form });
+  const data = await response.json().catch(() => null);
+  if (!response.ok) { studyStatus(problemText({ status: response.status, data })); return; }
+  $("study-json").value = JSON.stringify(data, null, 1);
+  const days = data.routes.reduce((n, r) => n + r.days.length, 0);
+  studyStatus(`${file.name}: ${days} route-days read. Run the study.`);
+}
+
 async function runStudy() {
   let request;
   try { request = JSON.parse($("study-json").value); } catch (error) {
@@ -134,6 +160,7 @@ function drawCoverage(routes, candidateId) {
 document.addEventListener("DOMContentLoaded", () => {
   $("study-example").addEventListener("click", () => loadStudyExample().catch((error) => studyStatus(`Unexpected: ${error.message}`)));
   $("study-run").addEventListener("click", () => runStudy().catch((error) => studyStatus(`Unexpected: ${error.message}`)));
+  $("study-csv").addEventListener("change", () => readExport().catch((error) => studyStatus(`Unexpected: ${error.message}`)));
 });
 
 window.coldrouteStudy = { answer: () => study.answer, coverage: () => study.plot && study.plot.data };

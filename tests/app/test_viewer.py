@@ -664,3 +664,32 @@ def test_the_electrification_study_shows_its_heat_map_and_coverage_curve(server,
     assert covered[-1] == 100 and capacities == sorted(capacities)
     assert capacities[-1] <= 70
     assert outside == []
+
+
+def test_a_telematics_export_becomes_the_studys_days_in_the_viewer(server, page, tmp_path):
+    tab, outside = page
+    tab.goto(f"{server.url}/viewer")
+    tab.get_by_test_id("api-key").fill(KEY)
+    tab.get_by_test_id("api-key").dispatch_event("change")
+    tab.get_by_test_id("study-example").click()
+    expect(tab.get_by_test_id("study-json")).to_have_value(re.compile("long-day"))
+    export = tmp_path / "telematics.csv"
+    export.write_text(
+        "route_id,date,stop_id,lat,lon,arrival,departure,delivery_kg\n"
+        "inner-city,2026-07-15,depot-simmering,48.1703,16.4207,,09:00,\n"
+        "inner-city,2026-07-15,billa,48.2006,16.3862,09:20,09:29,30\n"
+        "long-day,2026-07-16,depot-centre,48.21,16.37,,07:00,\n"
+        "long-day,2026-07-16,spar,48.1925,16.3671,07:15,07:25,25\n"
+        "long-day,2026-07-16,hofer,48.2036,16.3489,07:40,07:47,35\n",
+        encoding="utf-8",
+    )
+    tab.get_by_test_id("study-csv").set_input_files(str(export))
+    expect(tab.get_by_test_id("study-status")).to_contain_text("2 route-days read")
+    study = json.loads(tab.get_by_test_id("study-json").input_value())
+    assert [len(r["days"][0]["stops"]) for r in study["routes"]] == [1, 2]
+    tab.get_by_test_id("study-run").click()
+    expect(tab.get_by_test_id("study-status")).to_contain_text(
+        "2 route-days studied", timeout=120_000
+    )
+    assert tab.get_by_test_id("study-heatmap").locator(".day").count() == 2
+    assert outside == []

@@ -1,13 +1,13 @@
-"""The electrification study's request (the routes as driven, the candidate vans, a top-up)
-and its answer (per route and candidate: the days covered, the battery that covers them, the
-worst days; per candidate: the fleet)."""
+"""The electrification study's request (the routes as driven, the candidate vans, the charges
+a day may take) and its answer (per route and candidate: the days covered, the battery that
+covers them, the worst days; per candidate: the fleet)."""
 
 from __future__ import annotations
 
 import datetime as dt
 from typing import Literal
 
-from pydantic import Field, field_validator
+from pydantic import Field, field_validator, model_validator
 
 from core.params import (
     ClockTime,
@@ -47,42 +47,71 @@ class Weekdays(Params):
         return value
 
 
+class DrivenDay(Params):
+    """One day of a route as it was driven: its own stops, in the order driven, from its own
+    departure (a telematics export's day)."""
+
+    date: IsoDate = Field(..., description="The date, YYYY-MM-DD in the study's year.")
+    start_time: ClockTime = Field(..., description="Departure from the depot, local HH:MM.")
+    stops: list[Stop] = Field(
+        ...,
+        min_length=1,
+        max_length=MAX_ROUTE_STOPS,
+        description="The stops that day, in the order driven, as in /v1/plans.",
+    )
+
+
+Days = list[dt.date] | Weekdays | list[DrivenDay]
+
+
 class DrivenRoute(Params):
     """One route as the fleet drives it: its stops in the order driven, from its start time,
     on the days it is driven."""
 
     id: str = Field(..., min_length=1, max_length=64, description="The route's id, unique.")
     depot: Depot = Field(..., description="Where it starts and ends.")
-    stops: list[Stop] = Field(
-        ...,
+    stops: list[Stop] | None = Field(
+        None,
         min_length=1,
         max_length=MAX_ROUTE_STOPS,
         description="The stops in the order driven, as in /v1/plans (their windows aside: the "
-        "route is driven as it was).",
+        "route is driven as it was); needed unless each day gives its own.",
     )
-    start_time: ClockTime = Field(..., description="Departure from the depot, local HH:MM.")
+    start_time: ClockTime | None = Field(
+        None,
+        description="Departure from the depot, local HH:MM; needed unless each day gives its own.",
+    )
     product: Product | None = Field(
         None,
         description="The goods it carries (a class or a band, as a cargo box's product): each "
         "candidate's box carries them, at its own set-point when that is inside their band, "
         "else at the band's middle. Absent: each candidate's box as it is.",
     )
-    days: list[IsoDate] | Weekdays = Field(
+    days: list[IsoDate] | Weekdays | list[DrivenDay] = Field(
         ...,
         description="The dates it is driven (YYYY-MM-DD in the study's year, in order, each "
-        'once), or {"weekdays": ["mon", …]}: every such day of the year.',
+        'once), {"weekdays": ["mon", …]}: every such day of the year, or the days as driven, '
+        "each with its own start_time and stops.",
     )
 
     @field_validator("days")
     @classmethod
-    def _in_order(cls, value: list[dt.date] | Weekdays) -> list[dt.date] | Weekdays:
+    def _in_order(cls, value: Days) -> Days:
         if isinstance(value, list):
             if not value or len(value) > MAX_DAYS:
                 raise ValueError(f"between 1 and {MAX_DAYS} dates")
-            for k in range(1, len(value)):
-                if value[k] <= value[k - 1]:
-                    raise ValueError(f"days[{k}] ({value[k]}) is not after days[{k - 1}]")
+            dates = [d.date if isinstance(d, DrivenDay) else d for d in value]
+            for k in range(1, len(dates)):
+                if dates[k] <= dates[k - 1]:
+                    raise ValueError(f"days[{k}] ({dates[k]}) is not after days[{k - 1}]")
         return value
+
+    @model_validator(mode="after")
+    def _each_day_has_its_stops(self) -> DrivenRoute:
+        own = isinstance(self.days, list) and isinstance(self.days[0], DrivenDay)
+        if not own and (self.stops is None or self.start_time is None):
+            raise ValueError("stops and start_time are needed unless each day gives its own")
+        return self
 
 
 class Candidate(Params):
@@ -148,8 +177,8 @@ class WorstDay(Result):
     reason: Reason = Field(
         ...,
         description="heat or cold (the cab's and the unit's energy above the route's median "
-        "day, on a warmer or a colder day), or distance (the mildest day falls short too: the "
-        "drives and the stops alone).",
+        "day, on a warmer or a colder day), or distance (the day's drives take more above the "
+        "median day's than the weather does, or even the mildest day falls short).",
     )
     min_soc: float = Field(..., description="Lowest state of charge [–]; negative: empty.")
     required_kwh: float = Field(

@@ -4,8 +4,8 @@ its days with the sun and the temperatures of that date (:func:`core.physics.sim
 a date's weather is the climatology of the depot's place, :mod:`core.physics.weather`).
 
 A day is covered when the battery keeps its reserve all day
-(:class:`core.physics.battery.BatteryVerdict`: from the state of charge never clipped); with a
-top-up allowed, also when the charge it lacks fits in the top-up (:func:`topped_up`). Telematics
+(:class:`core.physics.battery.BatteryVerdict`: from the state of charge never clipped); with
+charges allowed, also when the charge it lacks fits in them (:func:`topped_up`). Telematics
 "EV suitability" assessments (Geotab's EVSA) leave the refrigeration unit out; here it is in,
 with every door opening, and the cold chain's verdict of each day.
 """
@@ -13,6 +13,7 @@ with every door opening, and the cold chain's verdict of each day.
 from __future__ import annotations
 
 import datetime as dt
+import itertools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -21,7 +22,7 @@ from pydantic import ValidationError
 
 from core.clock import departure
 from core.exceptions import CoreError, InvalidParameterError, ServiceUnavailableError
-from core.params import Location, VanParams, product_band
+from core.params import Location, Stop, VanParams, product_band
 from core.physics.battery import BatteryVerdict
 from core.physics.cold_chain import check_cold_chain
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
@@ -31,6 +32,7 @@ from core.planning.day.timeline import PLAN_DT_S, Timeline, build_timeline, rest
 from core.planning.electrification.model import (
     WEEKDAYS,
     ChargeOption,
+    DrivenDay,
     DrivenRoute,
     ElectrificationProblem,
     ElectrificationResult,
@@ -50,22 +52,41 @@ from core.planning.round.planner import check
 from core.planning.search.day import leg_roads
 from core.routing.roads import RoadRouter
 
+#: A day as driven: its departure and its stops.
+Driven = tuple[dt.time, list[Stop]]
 #: A route is driven once a day: its day lasts at most this [s].
 DAY_S = 86_400.0
 
 
 def route_dates(route: DrivenRoute, year: int, field: str) -> list[dt.date]:
     """The dates ``route`` is driven in ``year``; a date of another year names its field."""
+    return list(driven(route, year, field))
+
+
+def driven(route: DrivenRoute, year: int, field: str) -> dict[dt.date, Driven]:
+    """Each date ``route`` is driven in ``year``, in order, with that day's departure and
+    stops (its own, or the route's); a date of another year names its field."""
     if isinstance(route.days, Weekdays):
         wanted = {WEEKDAYS.index(day) for day in route.days.weekdays}
         every = (dt.date(year, 1, 1) + dt.timedelta(days=k) for k in range(366))
-        return [d for d in every if d.year == year and d.weekday() in wanted]
-    for k, date in enumerate(route.days):
+        dates = [d for d in every if d.year == year and d.weekday() in wanted]
+        return {d: _as_route(route) for d in dates}
+    out: dict[dt.date, Driven] = {}
+    days: list[dt.date | DrivenDay] = list(route.days)
+    for k, day in enumerate(days):
+        date = day.date if isinstance(day, DrivenDay) else day
         if date.year != year:
             raise InvalidParameterError(
-                f"{date} is not in the study's year {year}", f"{field}[{k}]"
+                f"{date} is not in the study's year {year}",
+                f"{field}[{k}].date" if isinstance(day, DrivenDay) else f"{field}[{k}]",
             )
-    return list(route.days)
+        out[date] = (day.start_time, day.stops) if isinstance(day, DrivenDay) else _as_route(route)
+    return out
+
+
+def _as_route(route: DrivenRoute) -> Driven:
+    assert route.start_time is not None and route.stops is not None  # DrivenRoute checks it
+    return route.start_time, route.stops
 
 
 def route_days(problem: ElectrificationProblem) -> int:
@@ -94,17 +115,18 @@ def check_study(problem: ElectrificationProblem) -> None:
                 )
             seen[item_id] = k
     for i, route in enumerate(problem.routes):
-        dates = route_dates(route, problem.year, f"routes[{i}].days")
-        if not dates:
+        days = driven(route, problem.year, f"routes[{i}].days")
+        if not days:
             raise InvalidParameterError("no day of the year is driven", f"routes[{i}].days")
-        for candidate in problem.candidates:
-            try:
-                check(_round(problem, route, candidate.van, dates[0]))
-            except CoreError as error:
-                if error.field == "timezone":  # the study's own
-                    raise
-                said = f"with candidate '{candidate.id}': {error.message}"
-                raise type(error)(said, error.field).under(f"routes[{i}]") from None
+        for date in _firsts(days):
+            for candidate in problem.candidates:
+                try:
+                    check(_round(problem, route, candidate.van, date, days[date]))
+                except CoreError as error:
+                    if error.field == "timezone":  # the study's own
+                        raise
+                    said = f"with candidate '{candidate.id}': {error.message}"
+                    raise type(error)(said, error.field).under(f"routes[{i}]") from None
 
 
 #: A place's weather for the year: by (lat, lon), the service's hours (None: climatology).
@@ -271,16 +293,30 @@ def carrying(van: VanParams, route: DrivenRoute) -> VanParams:
         ) from None
 
 
+def _firsts(days: dict[dt.date, Driven]) -> list[dt.date]:
+    """The first date of each different day (its departure and stops) among ``days``."""
+    seen: dict[tuple[dt.time, int], dt.date] = {}
+    for date, (start_time, stops) in days.items():
+        seen.setdefault((start_time, id(stops)), date)
+    return list(seen.values())
+
+
 def _round(
-    problem: ElectrificationProblem, route: DrivenRoute, van: VanParams, date: dt.date
+    problem: ElectrificationProblem,
+    route: DrivenRoute,
+    van: VanParams,
+    date: dt.date,
+    day: Driven,
 ) -> PlanProblem:
-    """The route on ``date`` as a round driven in its order by ``van`` (with its goods)."""
+    """The route's ``day`` on ``date`` as a round driven in its order by ``van`` (with the
+    route's goods)."""
+    start_time, stops = day
     return PlanProblem(
         date=date,
         timezone=problem.timezone,
         depot=route.depot,
-        stops=route.stops,
-        start_time=route.start_time,
+        stops=stops,
+        start_time=start_time,
         keep_order=True,
         van=carrying(van, route),
     )
@@ -304,17 +340,21 @@ def route_year(
         kinds.setdefault(key, []).append(candidate_id)
     out: dict[str, list[DayOutcome]] = {candidate_id: [] for candidate_id in vans}
     location = problem.location or Location(lat=route.depot.lat, lon=route.depot.lon)
-    for ids in kinds.values():
-        first = _round(problem, route, vans[ids[0]], dates[0])
+    days = {date: day for date, day in driven(route, problem.year, "days").items() if date in dates}
+    groups: dict[tuple[dt.time, int], list[dt.date]] = {}
+    for date, (start_time, stops) in days.items():  # days driven alike are laid out once
+        groups.setdefault((start_time, id(stops)), []).append(date)
+    for ids, group in itertools.product(kinds.values(), groups.values()):
+        first = _round(problem, route, vans[ids[0]], group[0], days[group[0]])
         timeline = _laid_out(first, router)
         if timeline.duration_s > DAY_S:  # it could not be driven again the next day
             raise InvalidParameterError(
-                f"the route's day lasts {timeline.duration_s / 3600:.1f} h (its drives, stops "
-                "and breaks in the order given): longer than a day",
+                f"the route's day of {group[0]} lasts {timeline.duration_s / 3600:.1f} h (its "
+                "drives, stops and breaks in the order given): longer than a day",
                 "stops",
             )
-        for date in dates:
-            start, _ = departure(date, route.start_time, problem.timezone, route.depot.lon)
+        for date in group:
+            start, _ = departure(date, first.start_time, problem.timezone, route.depot.lon)
             result = simulate(
                 timeline.speed,
                 PLAN_DT_S,
@@ -333,7 +373,7 @@ def route_year(
                 own = result if candidate_id == ids[0] else with_battery(result, battery)
                 van = first.van.model_copy(update={"battery": battery})
                 out[candidate_id].append(_day(date, van, own, problem.chargers))
-    return out
+    return {candidate_id: sorted(days, key=lambda d: d.date) for candidate_id, days in out.items()}
 
 
 def _laid_out(problem: PlanProblem, router: RoadRouter | None) -> Timeline:
@@ -366,7 +406,7 @@ def _day(
         t_max_c=float(result.ambient_c.max()),
         distance_m=result.distance_m,
         duration_s=result.duration_s,
-        covered_with_top_up=topped_up(result.battery, van, chargers),
+        covered_with_charging=topped_up(result.battery, van, chargers),
     )
 
 

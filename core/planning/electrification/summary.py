@@ -35,7 +35,7 @@ MIN_PARKED_H = 1.0
 class DayOutcome:
     """One route-day of one candidate: energy per consumer (``battery_loss``, ``total``)
     [kWh], the battery's verdict, the cold chain's, the day's coldest and warmest moments
-    [°C], its distance [m] and duration [s], and whether a top-up covers it."""
+    [°C], its distance [m] and duration [s], and whether the chargers' charges cover it."""
 
     date: dt.date
     energy_kwh: dict[str, float]
@@ -45,7 +45,7 @@ class DayOutcome:
     t_max_c: float
     distance_m: float
     duration_s: float
-    covered_with_top_up: bool
+    covered_with_charging: bool
 
 
 def route_outcome(
@@ -77,7 +77,7 @@ def summary(day: DayOutcome) -> DaySummary:
         margin_kwh=day.battery.margin_kwh,
         required_kwh=day.battery.required_capacity_kwh,
         energy_kwh=day.energy_kwh["total"],
-        covered_with_charging=day.covered_with_top_up,
+        covered_with_charging=day.covered_with_charging,
         cold_chain_holds=day.cold_chain_holds,
     )
 
@@ -88,7 +88,7 @@ def candidate_outcome(
     """One candidate's days on one route summed up."""
     required = np.array([d.battery.required_capacity_kwh for d in days])
     feasible = sum(d.battery.feasible for d in days)
-    topped = None if not chargers else sum(d.covered_with_top_up for d in days)
+    topped = None if not chargers else sum(d.covered_with_charging for d in days)
     return CandidateOutcome(
         id=candidate_id,
         days_total=len(days),
@@ -108,6 +108,11 @@ def candidate_outcome(
     )
 
 
+def _tenths(value: float) -> float:
+    """``value`` to a tenth, never −0.0."""
+    return round(value, 1) + 0.0
+
+
 def _whole(value: float) -> str:
     """``value`` to the unit, never "-0"."""
     return f"{round(value) + 0:d}"
@@ -122,25 +127,31 @@ def _mean_c(day: DayOutcome) -> float:
 
 
 def worst_days(days: Sequence[DayOutcome]) -> list[WorstDay]:
-    """The :data:`WORST_DAYS` days the battery ran lowest, lowest first, each with its reason:
-    distance when even the route's best day falls below the reserve; else heat or cold, as the
-    day is warmer or colder than the route's median day (its weather-driven energy — cab,
-    refrigeration, the battery's temperature loss — set beside the median day's)."""
+    """The :data:`WORST_DAYS` days the battery ran lowest, lowest first, each with its reason,
+    against the route's median day: distance when even the route's best day falls below the
+    reserve, or when the day's drives (traction) exceed the median day's by more than its
+    weather-driven energy (cab, refrigeration, the battery's temperature loss) does; else heat
+    or cold, as the day is warmer or colder than the median day."""
     best = max(days, key=lambda d: d.battery.min_soc)
     median_kwh = float(np.median([_thermal_kwh(d) for d in days]))
+    median_traction_kwh = float(np.median([d.energy_kwh["traction"] for d in days]))
     median_c = float(np.median([_mean_c(d) for d in days]))
     out = []
     for day in sorted(days, key=lambda d: (d.battery.min_soc, d.date))[:WORST_DAYS]:
+        energy = day.energy_kwh
+        driven_kwh = energy["traction"] - median_traction_kwh
+        weather_kwh = _thermal_kwh(day) - median_kwh
         reason: Reason = (
             "distance"
-            if not best.battery.feasible
+            if not best.battery.feasible or driven_kwh > max(weather_kwh, 0)
             else ("heat" if _mean_c(day) >= median_c else "cold")
         )
-        energy = day.energy_kwh
         detail = (
-            f"{_whole(day.t_min_c)} to {_whole(day.t_max_c)} °C: cab {energy['cabin']:.1f} kWh, "
+            f"{day.distance_m / 1000:.0f} km ({_tenths(driven_kwh):+.1f} kWh of traction over the "
+            f"route's median day), {_whole(day.t_min_c)} to {_whole(day.t_max_c)} °C: cab "
+            f"{energy['cabin']:.1f} kWh, "
             f"refrigeration {energy['refrigeration']:.1f} kWh, battery loss "
-            f"{energy['battery_loss']:.1f} kWh ({_thermal_kwh(day) - median_kwh:+.1f} kWh over "
+            f"{energy['battery_loss']:.1f} kWh ({_tenths(weather_kwh):+.1f} kWh over "
             f"the route's median day); {energy['total']:.1f} kWh in all, lowest charge "
             f"{day.battery.min_soc:.0%}"
         )

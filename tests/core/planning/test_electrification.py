@@ -15,6 +15,7 @@ from core.params import PRESETS, Depot, Stop
 from core.planning.electrification.model import (
     Candidate,
     ChargeOption,
+    DrivenDay,
     DrivenRoute,
     ElectrificationProblem,
     Weekdays,
@@ -302,3 +303,47 @@ def test_a_study_split_into_parts_answers_what_it_answers_whole(count):
     timing = {"runtime_s", "route_days_per_s"}
     assert split.model_dump(exclude=timing) == whole.model_dump(exclude=timing)
     assert split.route_days == 6
+
+
+def test_days_driven_with_their_own_stops_are_each_their_own_day():
+    """A telematics year: the route drove 10 stops on one day and 30 the next (same weather,
+    a day apart): each day is the plan of its own stops, and the long day is the worst, for
+    its distance."""
+    short, long = stops(10, seed=5), stops(30, seed=6)
+    days = [
+        DrivenDay(date=dt.date(2026, 7, 14), start_time="08:00", stops=short),
+        DrivenDay(date=dt.date(2026, 7, 15), start_time="07:00", stops=long),
+    ]
+    r = DrivenRoute(id="r1", depot=DEPOT, days=days)
+    (outcome,) = study(problem(r, VAN)).routes[0].candidates
+    assert outcome.days_total == 2
+    worst = outcome.worst_days[0]
+    assert worst.date == dt.date(2026, 7, 15) and worst.reason == "distance"
+    year = days_of(problem(r, VAN), r, VAN, [d.date for d in days])
+    planned = plan(
+        PlanProblem(
+            date=dt.date(2026, 7, 14),
+            timezone="Europe/Vienna",
+            depot=DEPOT,
+            stops=short,
+            start_time="08:00",
+            keep_order=True,
+            van=VAN,
+        )
+    )
+    assert year[0].distance_m == pytest.approx(planned.distance_m, rel=1e-9)
+    assert year[0].battery.min_soc == pytest.approx(planned.battery.min_soc, rel=1e-9)
+    assert year[1].distance_m > 2 * year[0].distance_m
+
+
+def test_a_route_without_its_stops_needs_days_that_have_theirs():
+    with pytest.raises(ValueError, match="needed unless each day gives its own"):
+        DrivenRoute(id="r1", depot=DEPOT, days=MONTHS[:1])
+    other_year = DrivenRoute(
+        id="r1",
+        depot=DEPOT,
+        days=[DrivenDay(date=dt.date(2025, 7, 14), start_time="08:00", stops=stops(3))],
+    )
+    with pytest.raises(CoreError) as caught:
+        study(problem(other_year, VAN))
+    assert caught.value.field == "routes[0].days[0].date"

@@ -1,0 +1,100 @@
+"""POST /v1/studies/electrification/from-csv: a telematics export (one row per stop visited)
+as the days of an electrification study, each bad cell named by its line and column."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tests.app.apps import app_client
+
+PATH = "/v1/studies/electrification/from-csv"
+DEPOT = {"id": "depot", "lat": 48.17, "lon": 16.42}
+STUDY = {
+    "year": 2026,
+    "timezone": "Europe/Vienna",
+    "routes": [{"id": "tour-1", "depot": DEPOT}, {"id": "tour-2", "depot": DEPOT}],
+    "candidates": [{"id": "reefer", "vehicle": {"preset": "ev-van-3.5t-reefer"}}],
+}
+HEADER = "route_id,date,stop_id,lat,lon,arrival,departure,delivery_kg,door_minutes"
+ROWS = [
+    "tour-1,2026-07-14,depot,48.17,16.42,,07:00,,",
+    "tour-1,2026-07-14,billa,48.2006,16.3862,07:20,07:29,30,4",
+    "tour-1,2026-07-14,spar,48.1925,16.3671,07:41,07:48:30,25,",
+    "tour-1,2026-07-14,depot,48.17,16.42,08:10,,,",
+    "tour-1,2026-07-15,depot,48.17,16.42,,06:30,,",
+    "tour-1,2026-07-15,hofer,48.2036,16.3489,06:55,07:02,35,3.5",
+    "tour-2,2026-07-14,depot,48.17,16.42,,08:00,,",
+    "tour-2,2026-07-14,bio,48.2108,16.3485,08:30,08:36,20,2",
+]
+
+
+def send(rows: list[str], study: dict = STUDY, header: str = HEADER):
+    csv_text = "\r\n".join([header, *rows]) + "\r\n"
+    return app_client().post(
+        PATH,
+        data={"study": json.dumps(study)},
+        files={"history": ("export.csv", csv_text.encode(), "text/csv")},
+    )
+
+
+def test_an_export_becomes_the_routes_days_and_the_study_runs_on_them():
+    response = send(ROWS)
+    assert response.status_code == 200, response.text
+    study = response.json()
+    first, second = study["routes"]
+    assert [d["date"] for d in first["days"]] == ["2026-07-14", "2026-07-15"]
+    day = first["days"][0]
+    assert day["start_time"] == "07:00"
+    billa, spar = day["stops"]
+    # service from arrival to departure; the door as the export says, else a minute
+    assert billa["service_time_s"] == 540 and billa["door_open_s"] == 240
+    assert spar["service_time_s"] == 450 and spar["door_open_s"] == 60
+    assert billa["delivery_kg"] == 30 and second["days"][0]["stops"][0]["id"] == "bio"
+    answer = app_client().post("/v1/studies/electrification", json=study)
+    assert answer.status_code == 200, answer.text
+    totals = [r["candidates"][0]["days_total"] for r in answer.json()["routes"]]
+    assert totals == [2, 1]
+
+
+@pytest.mark.parametrize(
+    ("rows", "field", "words"),
+    [
+        ([ROWS[1], *ROWS[2:4]], "history[2].stop_id", "begins with the departure"),
+        ([ROWS[0], ROWS[2], ROWS[1]], "history[4].arrival", "is before"),
+        ([ROWS[0], ROWS[1].replace("07:29", "07:10")], "history[3].departure", "before arrival"),
+        ([ROWS[0], ROWS[1].replace("07:20", "7h20")], "history[3].arrival", "not a time"),
+        ([ROWS[0], ROWS[1].replace("48.2006", "91")], "history[3].lat", "within -90..90"),
+        ([ROWS[0], ROWS[1].replace(",30,", ",lots,")], "history[3].delivery_kg", "not a number"),
+        ([ROWS[0], ROWS[1].replace(",4", ",20")], "history[3].door_minutes", "within 0..9"),
+        ([ROWS[0], ROWS[1].replace("tour-1", "tour-9")], "history[3].route_id", "no route"),
+        ([ROWS[0], ROWS[1].replace("2026-07-14", "14.7.2026")], "history[3].date", "not a date"),
+        ([*ROWS[4:6], *ROWS[0:2]], "history[4].date", "after a later day"),
+        ([*ROWS[0:2], *ROWS[6:8], ROWS[1]], "history[6].date", "not together"),
+        ([*ROWS[0:4], ROWS[1].replace("billa", "penny")], "history[6].stop_id", "after the return"),
+        (
+            [ROWS[0], ROWS[1], ROWS[1].replace("07:20", "07:40").replace("07:29", "07:45")],
+            "history[4].stop_id",
+            "twice",
+        ),
+        ([ROWS[0]], "history[2].stop_id", "without a stop"),
+        (ROWS[:4], "routes[1]", "no day of this route"),
+    ],
+)
+def test_a_bad_export_names_the_line_and_the_column(rows, field, words):
+    response = send(rows)
+    assert response.status_code == 422, response.text
+    error = response.json()["errors"][0]
+    assert error["field"] == field and words in error["message"], error
+
+
+def test_a_header_without_a_column_and_a_study_with_days_of_its_own_are_named():
+    missing = send(ROWS, header=HEADER.replace("arrival,", ""))
+    assert missing.status_code == 422
+    assert missing.json()["errors"][0]["field"] == "history"
+    assert "'arrival'" in missing.json()["detail"]
+    own = {**STUDY, "routes": [{**STUDY["routes"][0], "days": ["2026-07-14"]}]}
+    refused = send(ROWS, study=own)
+    assert refused.status_code == 422
+    assert refused.json()["errors"][0]["field"] == "routes[0].days"
