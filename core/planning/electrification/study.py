@@ -98,8 +98,8 @@ def route_days(problem: ElectrificationProblem) -> int:
 
 def check_study(problem: ElectrificationProblem) -> None:
     """Everything that can be checked before simulating: unique ids, the dates in the year,
-    each route a round every candidate can drive (its stops' ids, its payload, its start time
-    on its first day). Raises :class:`core.exceptions.CoreError` naming the field."""
+    each route a round every candidate can drive on each different day (its stops' ids, its
+    payload, its start time). Raises :class:`core.exceptions.CoreError` naming the field."""
     ids = {
         "routes": [r.id for r in problem.routes],
         "candidates": [c.id for c in problem.candidates],
@@ -126,7 +126,8 @@ def check_study(problem: ElectrificationProblem) -> None:
                     if error.field == "timezone":  # the study's own
                         raise
                     said = f"with candidate '{candidate.id}': {error.message}"
-                    raise type(error)(said, error.field).under(f"routes[{i}]") from None
+                    where = _day_field(route, date, f"routes[{i}]")
+                    raise type(error)(said, error.field).under(where) from None
 
 
 #: A place's weather for the year: by (lat, lon), the service's hours (None: climatology).
@@ -293,6 +294,15 @@ def carrying(van: VanParams, route: DrivenRoute) -> VanParams:
         ) from None
 
 
+def _day_field(route: DrivenRoute, date: dt.date, field: str) -> str:
+    """Where a day's stops and departure are in the request: the route's own, or the day's."""
+    if isinstance(route.days, list):
+        for k, day in enumerate(route.days):
+            if isinstance(day, DrivenDay) and day.date == date:
+                return f"{field}.days[{k}]"
+    return field
+
+
 def _firsts(days: dict[dt.date, Driven]) -> list[dt.date]:
     """The first date of each different day (its departure and stops) among ``days``."""
     seen: dict[tuple[dt.time, int], dt.date] = {}
@@ -351,7 +361,7 @@ def route_year(
             raise InvalidParameterError(
                 f"the route's day of {group[0]} lasts {timeline.duration_s / 3600:.1f} h (its "
                 "drives, stops and breaks in the order given): longer than a day",
-                "stops",
+                f"{_day_field(route, group[0], '')}.stops".lstrip("."),
             )
         for date in group:
             start, _ = departure(date, first.start_time, problem.timezone, route.depot.lon)

@@ -347,3 +347,18 @@ def test_a_route_without_its_stops_needs_days_that_have_theirs():
     with pytest.raises(CoreError) as caught:
         study(problem(other_year, VAN))
     assert caught.value.field == "routes[0].days[0].date"
+
+
+def test_a_bad_day_as_driven_is_named_in_its_place():
+    twice = [stops(2)[0], stops(2)[0]]
+    r = DrivenRoute(
+        id="r1",
+        depot=DEPOT,
+        days=[
+            DrivenDay(date=dt.date(2026, 7, 14), start_time="08:00", stops=stops(3)),
+            DrivenDay(date=dt.date(2026, 7, 15), start_time="08:00", stops=twice),
+        ],
+    )
+    with pytest.raises(CoreError) as caught:
+        study(problem(r, VAN))
+    assert caught.value.field == "routes[0].days[1].stops[1].id"
