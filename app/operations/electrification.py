@@ -8,7 +8,7 @@ from app.operations.vans import van_of
 from app.schemas.studies import ElectrificationRequest, ElectrificationResponse
 from app.settings import Settings
 from core.exceptions import CoreError, ServerLimitError, TooMuchToWaitForError
-from core.planning.electrification.model import Candidate, ElectrificationProblem
+from core.planning.electrification.model import Candidate, ElectrificationProblem, StudyFields
 from core.planning.electrification.study import (
     StudyPart,
     Weather,
@@ -20,6 +20,7 @@ from core.planning.electrification.study import (
     study_part,
     year_weather,
 )
+from core.planning.model import fields_of
 
 
 def electrification_problem(
@@ -37,13 +38,8 @@ def electrification_problem(
             van = van.model_copy(update={"refrigeration": request.refrigeration})
         candidates.append(Candidate(id=candidate.id, van=van))
     problem = ElectrificationProblem(
-        year=request.year,
-        timezone=request.timezone,
-        location=request.location,
-        routes=request.routes,
+        **fields_of(request, StudyFields),
         candidates=candidates,
-        chargers=request.chargers,
-        include_days=request.include_days,
         weather_source=request.weather.source,
     )
     simulated = route_days(problem) * len(candidates)

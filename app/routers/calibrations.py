@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import json
-from typing import Annotated, Any
+from typing import Annotated
 
 from fastapi import APIRouter, Body, File, Form, Request, UploadFile
-from fastapi.exceptions import RequestValidationError
-from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import CALIBRATION_EXAMPLE
 from app.operations import calibration as operation
+from app.routers.forms import json_object, text_of, validated
 from app.schemas.calibration import CalibrationRequest, CalibrationResponse
 from core.exceptions import InvalidParameterError
 
@@ -80,30 +78,15 @@ async def create_calibration_from_csv(
     telematics export becomes after one rename of its columns. A bad cell is a 422 naming the
     trip, the column and the row (`trips[1].speed_mps[40]`: the trip's 41st sample, line 42
     of its file)."""
-    try:
-        body: Any = json.loads(calibration)
-    except ValueError as error:
-        raise InvalidParameterError(f"not JSON ({error})", "calibration") from None
-    if not isinstance(body, dict):
-        raise InvalidParameterError("not a JSON object", "calibration")
+    body = json_object(calibration, "calibration")
     files: dict[str, str] = {}
     for upload in trips:
         name = upload.filename or ""
         if name in files:
             raise InvalidParameterError(f"the file {name[:60]!r} is sent twice", "trips")
-        try:
-            files[name] = (await upload.read()).decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise InvalidParameterError(
-                f"the file {name[:60]!r} is not UTF-8 text", "trips"
-            ) from None
+        files[name] = await text_of(upload, "trips")
     merged = await run_in_threadpool(operation.with_csv_trips, body, files)
-    try:
-        request = CalibrationRequest.model_validate(merged)
-    except ValidationError as error:
-        raise RequestValidationError(
-            [e | {"loc": ("body", *e["loc"])} for e in error.errors()], body=merged
-        ) from None
+    request = validated(CalibrationRequest, merged)
     return await pool.run(
         operation.run_calibration, request, settings, disconnected=http.is_disconnected
     )

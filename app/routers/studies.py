@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 import asyncio
-import json
 import time
-from typing import Annotated, Any
+from typing import Annotated
 
 from fastapi import APIRouter, Body, File, Form, Request, UploadFile
-from fastapi.exceptions import RequestValidationError
-from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from app.deps import ExecutorDep, SettingsDep
@@ -18,6 +15,7 @@ from app.operations.electrification import merged_answer, run_study_part, study_
 from app.operations.studies import run_scenarios as scenarios
 from app.operations.studies import sweep_speeds as sweep
 from app.operations.telematics import with_history
+from app.routers.forms import json_object, text_of, validated
 from app.schemas.studies import (
     ElectrificationRequest,
     ElectrificationResponse,
@@ -26,7 +24,6 @@ from app.schemas.studies import (
     SpeedSweepRequest,
     SpeedSweepResponse,
 )
-from core.exceptions import InvalidParameterError
 
 router = APIRouter(prefix="/studies", tags=["studies"])
 
@@ -147,20 +144,7 @@ async def electrification_study_from_csv(
     """The study with each route's days as driven, read from the export (a bad cell is a 422
     naming `history[<line>].<column>`, the file's line): send it to POST
     /v1/studies/electrification, or as a job of type electrification when it is large."""
-    try:
-        body: Any = json.loads(study)
-    except ValueError as error:
-        raise InvalidParameterError(f"not JSON ({error})", "study") from None
-    if not isinstance(body, dict):
-        raise InvalidParameterError("not a JSON object", "study")
-    try:
-        text = (await history.read()).decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise InvalidParameterError("the file is not UTF-8 text", "history") from None
+    body = json_object(study, "study")
+    text = await text_of(history, "history")
     merged = await run_in_threadpool(with_history, body, text)
-    try:
-        return ElectrificationRequest.model_validate(merged)
-    except ValidationError as error:
-        raise RequestValidationError(
-            [e | {"loc": ("body", *e["loc"])} for e in error.errors()], body=merged
-        ) from None
+    return validated(ElectrificationRequest, merged)

@@ -19,10 +19,8 @@ from core.params import (
 )
 from core.planning.electrification.model import (
     MAX_CANDIDATES,
-    MAX_ROUTES,
-    ChargeOption,
-    DrivenRoute,
     ElectrificationResult,
+    StudyFields,
 )
 from core.planning.studies import ScenarioCell, Season, SpeedPoint
 
@@ -140,27 +138,11 @@ class StudyWeather(ApiModel):
     )
 
 
-class ElectrificationRequest(ApiModel):
+class ElectrificationRequest(ApiModel, StudyFields):
     """The fleet's routes as driven over a year, and the vans they might be driven with."""
 
-    year: int = Field(..., ge=1901, le=2199, description="The year studied.")
-    timezone: str | None = Field(
-        None, max_length=64, description="IANA zone of the routes' clocks; absent: solar time."
-    )
-    location: Location | None = Field(
-        None, description="The place whose climate each date's weather is; absent: each depot's."
-    )
-    routes: list[DrivenRoute] = Field(
-        ..., min_length=1, max_length=MAX_ROUTES, description="The routes, as driven."
-    )
     candidates: list[CandidateRequest] = Field(
         ..., min_length=1, max_length=MAX_CANDIDATES, description="The vans to try."
-    )
-    chargers: list[ChargeOption] = Field(
-        default_factory=list,
-        max_length=10,
-        description="The charges a day may take, together (at the depot at lunch, on the way); "
-        "empty: a day is covered on one charge alone.",
     )
     refrigeration: RefrigerationStrategy | None = Field(
         None,
@@ -169,11 +151,6 @@ class ElectrificationRequest(ApiModel):
     )
     weather: StudyWeather = Field(
         default_factory=StudyWeather, description="Where each date's weather comes from."
-    )
-    include_days: bool = Field(
-        False,
-        description="Every route-day's figures in the answer (candidates[].days[]: the viewer's "
-        "heat map and coverage curve).",
     )
 
 

@@ -134,18 +134,18 @@ class ChargeOption(Params):
     )
 
 
-class ElectrificationProblem(Params):
-    """The fleet's routes over a year and the vans they might be driven with."""
+class StudyFields(Params):
+    """What a study's request and its core problem share: the year, the zone, the routes as
+    driven, the place of the climate, the charges a day may take, whether every day is listed."""
 
     year: int = Field(..., ge=1901, le=2199, description="The year studied.")
     timezone: str | None = Field(
-        None, description="IANA zone of the routes' clocks; null: from the depot's longitude."
+        None,
+        max_length=64,
+        description="IANA zone of the routes' clocks; null: from the depot's longitude.",
     )
     routes: list[DrivenRoute] = Field(
         ..., min_length=1, max_length=MAX_ROUTES, description="The routes, as driven."
-    )
-    candidates: list[Candidate] = Field(
-        ..., min_length=1, max_length=MAX_CANDIDATES, description="The vans to try."
     )
     location: Location | None = Field(
         None, description="The place whose climate each date's weather is; null: each depot's."
@@ -153,11 +153,21 @@ class ElectrificationProblem(Params):
     chargers: list[ChargeOption] = Field(
         default_factory=list,
         max_length=10,
-        description="The charges a day may take, together; empty: a day is covered on one "
-        "charge alone.",
+        description="The charges a day may take, together (at the depot at lunch, on the way); "
+        "empty: a day is covered on one charge alone.",
     )
     include_days: bool = Field(
-        False, description="Every route-day's figures in the answer (days[] per candidate)."
+        False,
+        description="Every route-day's figures in the answer (candidates[].days[]: the viewer's "
+        "heat map and coverage curve).",
+    )
+
+
+class ElectrificationProblem(StudyFields):
+    """The fleet's routes over a year and the vans they might be driven with."""
+
+    candidates: list[Candidate] = Field(
+        ..., min_length=1, max_length=MAX_CANDIDATES, description="The vans to try."
     )
     weather_source: WeatherSourceName = Field(
         "climatology",
