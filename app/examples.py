@@ -435,7 +435,7 @@ def record() -> dict[str, Any]:
         "scenarios": studies.run_scenarios(
             ScenariosRequest.model_validate(SCENARIOS_EXAMPLE), settings
         ).model_dump(mode="json"),
-        "electrification": electrification.run_electrification(
+        "electrification": electrification.run_study(
             ElectrificationRequest.model_validate(ELECTRIFICATION_EXAMPLE), settings
         ).model_dump(mode="json")
         | {"runtime_s": 4.2, "route_days_per_s": 124.0},  # this machine's, not the reader's

@@ -236,6 +236,12 @@ class Executor:
         future.add_done_callback(lambda _: self.release())
         return future
 
+    def schedule(self, fn: Callable[..., T], args: tuple[Any, ...]) -> Future[T]:
+        """Run ``fn(*args)`` in the pool beside the requests (a part of a job that holds a
+        worker: it waits in the pool's own line when every worker is busy); its future, which
+        ``cancel()`` stops and a shutdown cancels."""
+        return self._schedule(fn, args)
+
     async def _acquire(
         self, disconnected: Callable[[], Awaitable[bool]] | None, deadline_s: float | None
     ) -> None:

@@ -81,7 +81,14 @@ class Settings(BaseSettings):
         200_000,
         ge=1,
         description="Most route-days × candidates one electrification study simulates (50 "
-        "routes × 365 days × 3 candidates is 54,750 × 3); beyond, a 413 names the limit.",
+        "routes × 365 days × 3 candidates is 54,750); beyond, a 413 names the limit.",
+    )
+    job_part_route_days: int = Field(
+        2_000,
+        ge=1,
+        description="A study submitted as a job is run in parts of about this many route-days "
+        "× candidates each (some seconds of work), shared out over the workers: a worker lost "
+        "costs one part, and the job's progress is told part by part.",
     )
     max_sync_route_days: int = Field(
         1_000,

@@ -6,22 +6,16 @@ from __future__ import annotations
 import asyncio
 import copy
 import random
-import subprocess
-import sys
 import time
-import uuid
 
 import httpx
 import numpy as np
-import psycopg
-import redis
 
 from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
-from benchmarks.common import Server, print_table, vienna_stops
+from benchmarks.common import Server, celery_cluster, print_table, vienna_stops
 
 LOAD_S = 60.0
 CLIENTS = 8
-POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
 
 
 def plan_with(n_stops: int, time_limit_s: float = 1.0, seed: int | None = None) -> dict:
@@ -161,57 +155,11 @@ def jobs_per_second(n_jobs: int = 40) -> None:
         rows.append(["the server's own pool (2 processes)", n_jobs, f"{rate:.2f}", failed])
     finally:
         local.close()
-    schema = f"bench_{uuid.uuid4().hex[:8]}"
-    broker = "redis://127.0.0.1:6379/13"
-    redis.Redis.from_url(broker).flushdb()
-    with psycopg.connect(POSTGRES, autocommit=True) as connection:
-        connection.execute(f"CREATE SCHEMA {schema}")
-    env = {
-        "COLDROUTE_DATABASE_URL": "postgresql+psycopg://postgres@127.0.0.1:5432/test"
-        f"?options=-csearch_path%3D{schema}",
-        "COLDROUTE_BROKER_URL": broker,
-        "COLDROUTE_BROKER_QUEUE": f"jobs-{schema}",
-        "COLDROUTE_WORKERS": "1",
-    }
-    server = Server(env).start()
-    workers = [
-        subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                "celery",
-                "-A",
-                "app.jobs.worker",
-                "worker",
-                "--pool=threads",
-                "--concurrency=1",
-                "--loglevel=WARNING",
-                "-n",
-                f"bench{i}@%h",
-            ],
-            env=server.env,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-        for i in (1, 2)
-    ]
-    try:
-        time.sleep(5)  # the workers connect and warm their process
+    with celery_cluster([1, 1]) as server:
         rate, failed = _throughput(server.url, n_jobs)
         rows.append(
             ["Celery, 2 workers × 1 process, PostgreSQL + Redis", n_jobs, f"{rate:.2f}", failed]
         )
-    finally:
-        for worker in workers:
-            worker.terminate()
-        for worker in workers:
-            try:
-                worker.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                worker.kill()
-        server.close()
-        with psycopg.connect(POSTGRES, autocommit=True) as connection:
-            connection.execute(f"DROP SCHEMA {schema} CASCADE")
     print_table(
         "Jobs per second (25-stop plans, submitted at once, until all have succeeded)",
         ["runner", "jobs", "jobs/s", "failed"],

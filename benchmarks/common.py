@@ -9,6 +9,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import uuid
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -144,6 +145,67 @@ def running_server(env: dict[str, str] | None = None) -> Iterator[str]:
         yield server.url
     finally:
         server.close()
+
+
+POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
+
+
+@contextmanager
+def celery_cluster(processes: Sequence[int], env: dict[str, str] | None = None) -> Iterator[Server]:
+    """A server with Celery workers (one per entry of ``processes``, each with that many worker
+    processes and Celery threads, as ``make worker``) on this machine's PostgreSQL (a schema
+    of its own) and Redis (database 13, emptied); yields the server."""
+    import psycopg
+    import redis
+
+    schema = f"bench_{uuid.uuid4().hex[:8]}"
+    broker = "redis://127.0.0.1:6379/13"
+    redis.Redis.from_url(broker).flushdb()
+    with psycopg.connect(POSTGRES, autocommit=True) as connection:
+        connection.execute(f"CREATE SCHEMA {schema}")
+    shared = {
+        "COLDROUTE_DATABASE_URL": "postgresql+psycopg://postgres@127.0.0.1:5432/test"
+        f"?options=-csearch_path%3D{schema}",
+        "COLDROUTE_BROKER_URL": broker,
+        "COLDROUTE_BROKER_QUEUE": f"jobs-{schema}",
+        "COLDROUTE_WORKERS": "1",
+    } | (env or {})
+    server = Server(shared).start()
+    workers = [
+        subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "celery",
+                "-A",
+                "app.jobs.worker",
+                "worker",
+                "--pool=threads",
+                f"--concurrency={n}",
+                "--loglevel=WARNING",
+                "-n",
+                f"bench{i}@%h",
+            ],
+            env=server.env | {"COLDROUTE_WORKERS": str(n)},
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        for i, n in enumerate(processes)
+    ]
+    try:
+        time.sleep(5)  # the workers connect and warm their processes
+        yield server
+    finally:
+        for worker in workers:
+            worker.terminate()
+        for worker in workers:
+            try:
+                worker.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                worker.kill()
+        server.close()
+        with psycopg.connect(POSTGRES, autocommit=True) as connection:
+            connection.execute(f"DROP SCHEMA {schema} CASCADE")
 
 
 def pyvrp_vrptw(

@@ -5,7 +5,9 @@ broker (Redis). Late acknowledgement: a worker that dies mid-job leaves its mess
 worker (and the servers' sweep requeues a job whose heartbeat stopped). A job is claimed with
 one conditional ``UPDATE``, so a message delivered twice runs the job once. Each message is one
 attempt; a retry (:class:`app.jobs.lifecycle.RetryPolicy`) puts the job back in the queue with
-its backoff, and the servers' dispatcher sends it again when it is due.
+its backoff, and the servers' dispatcher sends it again when it is due. A job run in parts
+(an electrification study) is shared out over every worker (:mod:`app.jobs.fanout`): its
+runner calls helpers through the broker, and a part lost with its worker is redone.
 
 Run a worker with ``celery -A app.jobs.worker worker --pool=threads`` (``make worker``) and
 ``COLDROUTE_BROKER_URL`` / ``COLDROUTE_DATABASE_URL`` set: Celery's threads take the messages,
@@ -20,13 +22,16 @@ from celery import Celery, Task
 from sqlalchemy.exc import OperationalError
 
 from app.execution import WorkerPool
+from app.jobs.fanout import PartedRun
 from app.jobs.lifecycle import JOB_EXTRA_TIME_S, Lifecycle, time_limit_s
 from app.jobs.store import store_for
-from app.operations.kinds import run_job
+from app.operations.kinds import JOB_KINDS, run_job
 from app.settings import Settings, get_settings
 
 #: The name of the task that runs a job.
 TASK = "coldroute.run_job"
+#: The name of the task that helps run a job's parts (:mod:`app.jobs.fanout`).
+HELP_TASK = "coldroute.help_job"
 #: How soon a message whose job could not be claimed (the database away) is taken again [s].
 DATABASE_RETRY_S = 2
 
@@ -67,6 +72,7 @@ def _celery(broker_url: str, queue: str, visibility_s: int) -> Celery:
         },
     )
     app.task(bind=True, name=TASK)(_run_job)
+    app.task(bind=True, name=HELP_TASK)(_help_job)
     return app
 
 
@@ -83,7 +89,7 @@ def _run_job(task: Task, job_id: str) -> str:
     beside it would starve and the job would look lost.
     """
     settings = get_settings()
-    lifecycle = Lifecycle(store_for(settings.database_url), settings, task.request.id)
+    lifecycle = Lifecycle(store_for(settings.database_url), settings, _runner(task))
     try:
         job = lifecycle.claim(job_id)
     except OperationalError as error:
@@ -92,10 +98,36 @@ def _run_job(task: Task, job_id: str) -> str:
         raise task.retry(countdown=DATABASE_RETRY_S, max_retries=None, exc=error) from None
     if job is None:
         return "not queued (done, cancelled, waiting for a retry or running elsewhere)"
+    if JOB_KINDS[job.type].fanout is not None:
+        return _parted(task, lifecycle).coordinate(job)
     future = _pool(settings.workers).schedule(
         run_job, (job.type, job.request, settings), timeout_s=time_limit_s(job)
     )
     return lifecycle.watch(job, future)
+
+
+def _runner(task: Task) -> str:
+    """The runner's name: the worker's and the message's (which worker ran what)."""
+    return f"{task.request.hostname}/{task.request.id}"
+
+
+def _help_job(task: Task, job_id: str) -> str:
+    """Run parts of a job run in parts until none is left to take."""
+    settings = get_settings()
+    lifecycle = Lifecycle(store_for(settings.database_url), settings, _runner(task))
+    return f"{_parted(task, lifecycle).help(job_id)} parts done"
+
+
+def _parted(task: Task, lifecycle: Lifecycle) -> PartedRun:
+    """This worker's share of a job run in parts: one part at a time per Celery thread (as
+    many threads as processes: ``make worker``), helpers called through the broker."""
+    pool = _pool(lifecycle.settings.workers)
+
+    def call_helpers(job_id: str, count: int) -> None:
+        for _ in range(count):
+            task.app.send_task(HELP_TASK, args=[job_id])
+
+    return PartedRun(lifecycle, lambda fn, args: pool.schedule(fn, args), 1, call_helpers)
 
 
 def stop_pool() -> None:

@@ -113,26 +113,25 @@ class Lifecycle:
         """Wait for the run of ``job`` in ``future`` (a worker process), beating its heartbeat,
         stopping it when it is cancelled or runs out of time, and record how it ended. The
         database may be away meanwhile: the run goes on, and what it records waits for the
-        database (:meth:`_stored`) — an outage costs no run."""
-        limit_s = time_limit_s(job)
-        deadline = time.monotonic() + limit_s
+        database (:meth:`stored`) — an outage costs no run."""
+        deadline = time.monotonic() + time_limit_s(job)
         while True:
             try:
                 result = future.result(timeout=self.settings.job_heartbeat_s)
             except TimeoutError:
                 if future.done():  # the pool's own time limit ended the run
-                    return self._out_of_time(job, limit_s)
+                    return self.out_of_time(job)
             except CancelledError:  # the server shuts down: another run, not counted
-                self._stored(lambda: self.store.requeue(job.id, self.runner, count=False))
+                self.stored(lambda: self.store.requeue(job.id, self.runner, count=False))
                 return "interrupted"
             except Exception as error:
-                return self._failed(job, error)
+                return self.failed(job, error)
             else:
-                self._stored(partial(self.store.finish, job.id, self.runner, result=result))
+                self.stored(partial(self.store.finish, job.id, self.runner, result=result))
                 return "succeeded"
             if time.monotonic() > deadline:
                 future.cancel()
-                return self._out_of_time(job, limit_s)
+                return self.out_of_time(job)
             try:
                 self.store.heartbeat([job.id], self.runner)
                 cancelled = self.store.cancelled_among([job.id])
@@ -143,7 +142,7 @@ class Lifecycle:
                 future.cancel()  # Pebble stops the worker process
                 return "cancelled"
 
-    def _stored(self, write: Callable[[], object]) -> None:
+    def stored(self, write: Callable[[], object]) -> None:
         """Record an ending, waiting out a database that is away (every heartbeat period, up
         to :data:`DATABASE_PATIENCE_S`; then the job's heartbeat is stale and it runs again)."""
         given_up = time.monotonic() + DATABASE_PATIENCE_S
@@ -157,19 +156,22 @@ class Lifecycle:
                 _log.warning("the database is away (%s); the job's ending waits for it", error)
                 time.sleep(self.settings.job_heartbeat_s)
 
-    def _out_of_time(self, job: JobView, limit_s: float) -> Ending:
+    def out_of_time(self, job: JobView) -> Ending:
+        """Fail a job that ran out of time."""
+        limit_s = time_limit_s(job)
         problem = problem_body(504, "Time limit exceeded", f"the job ran longer than {limit_s:g} s")
-        self._stored(lambda: self.store.finish(job.id, self.runner, error=problem))
+        self.stored(lambda: self.store.finish(job.id, self.runner, error=problem))
         return "failed"
 
-    def _failed(self, job: JobView, error: Exception) -> Ending:
+    def failed(self, job: JobView, error: BaseException) -> Ending:
+        """Retry a run that failed, after its backoff, if another may succeed; else fail."""
         problem, retryable = failure(error)
         wait_s = self.policy.retry_after_s(job.attempts) if retryable else None
         if wait_s is not None:
-            self._stored(lambda: self.store.requeue(job.id, self.runner, after_s=wait_s))
+            self.stored(lambda: self.store.requeue(job.id, self.runner, after_s=wait_s))
             _log.warning("job %s failed (%s); again in %g s", job.id, problem["detail"], wait_s)
             return "retrying"
-        self._stored(lambda: self.store.finish(job.id, self.runner, error=problem))
+        self.stored(lambda: self.store.finish(job.id, self.runner, error=problem))
         return "failed"
 
     def sweep(self) -> list[JobView]:

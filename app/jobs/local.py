@@ -1,5 +1,6 @@
 """The server's own job runner: jobs on the server's worker pool, a few at a time, with the one
-lifecycle (:mod:`app.jobs.lifecycle`)."""
+lifecycle (:mod:`app.jobs.lifecycle`); a job run in parts (:mod:`app.jobs.fanout`) holds one
+worker's place and shares its parts out over every worker."""
 
 from __future__ import annotations
 
@@ -8,9 +9,10 @@ import contextlib
 import logging
 
 from app.execution import Executor
+from app.jobs.fanout import PartedRun
 from app.jobs.lifecycle import SWEEP_EVERY_S, Lifecycle, runner_name
 from app.jobs.store import JobStore, JobView
-from app.operations.kinds import run_job
+from app.operations.kinds import JOB_KINDS, run_job
 from app.settings import Settings
 
 _log = logging.getLogger("coldroute.jobs")
@@ -75,8 +77,13 @@ class LocalRunner:
         if job is None:
             self.executor.release()
             return False
-        future = self.executor.start(run_job, job.type, job.request, self.settings)
-        watch = asyncio.create_task(asyncio.to_thread(self.lifecycle.watch, job, future))
+        if JOB_KINDS[job.type].fanout is not None:  # in parts, over every worker
+            parted = PartedRun(self.lifecycle, self.executor.schedule, self.settings.workers)
+            watch = asyncio.create_task(asyncio.to_thread(parted.coordinate, job))
+            watch.add_done_callback(lambda _: self.executor.release())
+        else:
+            future = self.executor.start(run_job, job.type, job.request, self.settings)
+            watch = asyncio.create_task(asyncio.to_thread(self.lifecycle.watch, job, future))
         self.watching.add(watch)
         watch.add_done_callback(self._ended)
         return True

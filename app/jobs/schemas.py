@@ -38,6 +38,16 @@ class JobSubmission(ApiModel):
     )
 
 
+class JobProgress(ApiModel):
+    """How far a job run in parts is (an electrification study: its route-days × candidates,
+    cut into parts shared out over the workers)."""
+
+    done: int = Field(..., description="Work done: the parts finished, by their weight.")
+    total: int = Field(..., description="Work in all (electrification: route-days × candidates).")
+    parts_done: int = Field(..., description="Parts finished (each is kept when a worker is lost).")
+    parts_total: int = Field(..., description="Parts in all.")
+
+
 class JobSummary(ApiModel):
     """A job's state."""
 
@@ -52,6 +62,11 @@ class JobSummary(ApiModel):
         None, strict=False, description="When it ended (UTC)."
     )
     attempts: int = Field(..., description="Runs so far (a lost worker means another run).")
+    progress: JobProgress | None = Field(
+        None,
+        description="A job run in parts, once its runner has cut it up: how far it is. Null "
+        "for the others.",
+    )
 
 
 class JobOut(JobSummary):

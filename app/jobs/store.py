@@ -16,12 +16,12 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
-from sqlalchemy import ColumnElement, case, delete, select, text, update
+from sqlalchemy import ColumnElement, case, delete, func, select, text, update
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
 from app.database import database_for, now
-from app.jobs.models import ACTIVE, FINISHED, Job
+from app.jobs.models import ACTIVE, FINISHED, Job, JobPart
 
 
 def request_hash(job_type: str, request: dict[str, Any]) -> str:
@@ -48,6 +48,7 @@ class JobView:
     started_at: dt.datetime | None
     heartbeat_at: dt.datetime | None
     finished_at: dt.datetime | None
+    context: dict[str, Any] | None = None
 
     @classmethod
     def of(cls, job: Job) -> JobView:
@@ -66,7 +67,31 @@ class JobView:
             started_at=job.started_at,
             heartbeat_at=job.heartbeat_at,
             finished_at=job.finished_at,
+            context=job.context,
         )
+
+
+@dataclass(frozen=True)
+class PartView:
+    """A part of a job run in parts (:mod:`app.jobs.fanout`), as claimed."""
+
+    job_id: str
+    index: int
+    spec: dict[str, Any]
+    weight: int
+    attempts: int
+    runner: str | None
+
+
+@dataclass(frozen=True)
+class Progress:
+    """How far a job run in parts is: its parts' weights done and in all (the work they
+    stand for, e.g. route-days), and its parts done and in all."""
+
+    done: int
+    total: int
+    parts_done: int
+    parts_total: int
 
 
 class IdempotencyConflictError(Exception):
@@ -265,6 +290,11 @@ class JobStore:
             job = session.get(Job, job_id)
             return None if job is None else JobView.of(job)
 
+    def status_of(self, job_id: str) -> str | None:
+        """A job's status (None: no such job), without reading its request or result."""
+        with self.transaction() as session:
+            return session.scalars(select(Job.status).where(Job.id == job_id)).first()
+
     def cancelled_among(self, job_ids: list[str]) -> list[str]:
         """Which of these jobs were cancelled."""
         if not job_ids:
@@ -332,6 +362,16 @@ class JobStore:
                 .values(dispatched_at=None)
             )
 
+    def fail(self, job_id: str, error: dict[str, Any]) -> bool:
+        """Fail a running job, whoever runs it (a part of it cannot be done)."""
+        with self.transaction() as session:
+            done = session.execute(
+                update(Job)
+                .where(Job.id == job_id, Job.status == "running")
+                .values(status="failed", error=error, finished_at=now())
+            )
+            return bool(done.rowcount == 1)  # type: ignore[attr-defined]
+
     def fail_exhausted(self, job_id: str, max_attempts: int, error: dict[str, Any]) -> bool:
         """Fail a queued or running job that has used its attempts."""
         with self.transaction() as session:
@@ -342,14 +382,176 @@ class JobStore:
             )
             return bool(done.rowcount == 1)  # type: ignore[attr-defined]
 
+    # Jobs run in parts: each part is claimed, beaten and finished like a job, by one runner.
+
+    def set_parts(
+        self, job_id: str, runner: str, context: dict[str, Any], parts: list[tuple[Any, int]]
+    ) -> bool:
+        """Store the plan of a job ``runner`` runs: what its parts share and each part (its
+        spec and weight), all queued; False when the job is no longer this runner's."""
+        with self.transaction() as session:
+            done = session.execute(
+                update(Job)
+                .where(Job.id == job_id, Job.status == "running", Job.runner == runner)
+                .values(context=context)
+            )
+            if done.rowcount != 1:  # type: ignore[attr-defined]
+                return False
+            session.execute(delete(JobPart).where(JobPart.job_id == job_id))
+            session.add_all(
+                JobPart(job_id=job_id, index=k, spec=spec, weight=weight, status="queued")
+                for k, (spec, weight) in enumerate(parts)
+            )
+            return True
+
+    def claim_part(self, job_id: str, runner: str) -> PartView | None:
+        """Take the first queued part of a running job for ``runner``, in one conditional
+        ``UPDATE`` (two runners never take one part)."""
+        first = (
+            select(JobPart.index)
+            .where(JobPart.job_id == job_id, JobPart.status == "queued")
+            .order_by(JobPart.index)
+            .limit(1)
+        )
+        if self.engine.dialect.name == "postgresql":
+            first = first.with_for_update(skip_locked=True)
+        with self.transaction() as session:
+            running = select(Job.id).where(Job.id == job_id, Job.status == "running").exists()
+            taken = session.execute(
+                update(JobPart)
+                .where(
+                    JobPart.job_id == job_id,
+                    JobPart.index == first.scalar_subquery(),
+                    JobPart.status == "queued",
+                    running,
+                )
+                .values(
+                    status="running",
+                    runner=runner,
+                    heartbeat_at=now(),
+                    attempts=JobPart.attempts + 1,
+                )
+                .returning(JobPart.index)
+            ).first()
+            if taken is None:
+                return None
+            part = session.get(JobPart, (job_id, taken[0]))
+            return None if part is None else _part_view(part)
+
+    def heartbeat_parts(self, job_id: str, indices: list[int], runner: str) -> None:
+        if not indices:
+            return
+        with self.transaction() as session:
+            session.execute(
+                update(JobPart)
+                .where(
+                    JobPart.job_id == job_id,
+                    JobPart.index.in_(indices),
+                    JobPart.status == "running",
+                    JobPart.runner == runner,
+                )
+                .values(heartbeat_at=now())
+            )
+
+    def finish_part(self, job_id: str, index: int, runner: str, result: dict[str, Any]) -> bool:
+        """Record a part's result; False when it is no longer ``runner``'s (it was judged lost
+        and given to another): the result is dropped, so nothing counts twice."""
+        with self.transaction() as session:
+            done = session.execute(
+                update(JobPart)
+                .where(
+                    JobPart.job_id == job_id,
+                    JobPart.index == index,
+                    JobPart.status == "running",
+                    JobPart.runner == runner,
+                )
+                .values(status="done", result=result)  # the runner stays: who did it
+            )
+            return bool(done.rowcount == 1)  # type: ignore[attr-defined]
+
+    def release_part(self, job_id: str, index: int, runner: str, count: bool = True) -> None:
+        """Put a part ``runner`` holds back in the queue: its worker was lost, or (not to
+        ``count`` as an attempt) its run was cut short by a shutdown."""
+        values: dict[str, Any] = {"status": "queued", "runner": None}
+        if not count:
+            values["attempts"] = JobPart.attempts - 1
+        with self.transaction() as session:
+            session.execute(
+                update(JobPart)
+                .where(
+                    JobPart.job_id == job_id,
+                    JobPart.index == index,
+                    JobPart.status == "running",
+                    JobPart.runner == runner,
+                )
+                .values(values)
+            )
+
+    def requeue_lost_parts(self, job_id: str, stale_after_s: float) -> list[PartView]:
+        """Queue again the running parts whose runner has been silent for ``stale_after_s``
+        (a worker was killed); those parts, as they were."""
+        silent_since = now() - dt.timedelta(seconds=stale_after_s)
+        lost = (
+            JobPart.job_id == job_id,
+            JobPart.status == "running",
+            JobPart.heartbeat_at < silent_since,
+        )
+        with self.transaction() as session:
+            parts = [_part_view(p) for p in session.scalars(select(JobPart).where(*lost))]
+            if parts:
+                session.execute(
+                    update(JobPart)
+                    .where(*lost, JobPart.index.in_([p.index for p in parts]))
+                    .values(status="queued", runner=None)
+                )
+            return parts
+
+    def part_results(self, job_id: str) -> list[dict[str, Any]]:
+        """The results of a job's parts, in their order (each part once)."""
+        with self.transaction() as session:
+            query = (
+                select(JobPart.result)
+                .where(JobPart.job_id == job_id, JobPart.status == "done")
+                .order_by(JobPart.index)
+            )
+            return [result for result in session.scalars(query) if result is not None]
+
+    def progress(self, job_ids: list[str]) -> dict[str, Progress]:
+        """How far each of these jobs run in parts is (jobs not run in parts are absent)."""
+        if not job_ids:
+            return {}
+        done = case((JobPart.status == "done", 1), else_=0)
+        with self.transaction() as session:
+            rows = session.execute(
+                select(
+                    JobPart.job_id,
+                    func.sum(JobPart.weight * done),
+                    func.sum(JobPart.weight),
+                    func.sum(done),
+                    func.count(),
+                )
+                .where(JobPart.job_id.in_(job_ids))
+                .group_by(JobPart.job_id)
+            )
+            return {
+                str(job_id): Progress(int(w_done), int(w_all), int(n_done), int(n_all))
+                for job_id, w_done, w_all, n_done, n_all in rows
+            }
+
     def purge(self, retention_s: float) -> int:
-        """Delete jobs finished more than ``retention_s`` ago; how many."""
+        """Delete jobs finished more than ``retention_s`` ago, and their parts; how many."""
         before = now() - dt.timedelta(seconds=retention_s)
         with self.transaction() as session:
+            expired = select(Job.id).where(Job.status.in_(FINISHED), Job.finished_at < before)
+            session.execute(delete(JobPart).where(JobPart.job_id.in_(expired)))
             gone = session.execute(
                 delete(Job).where(Job.status.in_(FINISHED), Job.finished_at < before)
             )
             return int(gone.rowcount)  # type: ignore[attr-defined]
+
+
+def _part_view(part: JobPart) -> PartView:
+    return PartView(part.job_id, part.index, part.spec, part.weight, part.attempts, part.runner)
 
 
 def _due(moment: dt.datetime) -> ColumnElement[bool]:

@@ -31,6 +31,27 @@ ResultT = TypeVar("ResultT")
 
 
 @dataclass(frozen=True)
+class Fanout(Generic[RequestT]):
+    """How a job is run in parts shared out over the workers (:mod:`app.jobs.fanout`).
+
+    Attributes
+    ----------
+    plan
+        The request checked and cut up (in a worker): what every part needs (JSON) and each
+        part's spec (JSON) with its weight (the work it stands for, e.g. route-days).
+    run_part
+        One part's work (in a worker): its result as JSON.
+    merge
+        The answer of every part's result, in their order, and the time it took [s]: the same
+        however the work was cut up.
+    """
+
+    plan: Callable[[RequestT, Settings], tuple[dict[str, Any], list[tuple[Any, int]]]]
+    run_part: Callable[[RequestT, Settings, dict[str, Any], Any], dict[str, Any]]
+    merge: Callable[[RequestT, Settings, dict[str, Any], list[dict[str, Any]], float], BaseModel]
+
+
+@dataclass(frozen=True)
 class JobKind(Generic[RequestT, ResultT]):
     """One kind of job.
 
@@ -43,20 +64,23 @@ class JobKind(Generic[RequestT, ResultT]):
     check
         What can be refused at submission, without solving (raises a core error).
     run
-        The work, in a worker process: the core's result.
+        The work, in a worker process: the core's result (None: run in parts, ``fanout``).
     answer
         The result as the endpoint answers it.
     time_limit_s
         The solver budget the request asks for [s].
+    fanout
+        How the job runs in parts over the workers, if it does.
     """
 
     request: type[RequestT]
     response: type[BaseModel]
     summary: str
     check: Callable[[RequestT, Settings], None]
-    run: Callable[[RequestT, Settings], ResultT]
+    run: Callable[[RequestT, Settings], ResultT] | None
     answer: Callable[[RequestT, ResultT], BaseModel]
     time_limit_s: Callable[[RequestT], float]
+    fanout: Fanout[RequestT] | None = None
 
 
 JOB_KINDS: dict[str, JobKind[Any, Any]] = {
@@ -101,9 +125,14 @@ JOB_KINDS: dict[str, JobKind[Any, Any]] = {
         ElectrificationResponse,
         "of /v1/studies/electrification",
         electrification.check_electrification,
-        electrification.run_electrification_job,
+        None,
         lambda _request, response: response,
-        lambda _request: 0.0,  # no solver: the routes' simulations alone
+        electrification.time_limit_s,  # no solver: the routes' simulations alone
+        Fanout(
+            electrification.plan_study,
+            electrification.run_study_part,
+            electrification.merged_answer,
+        ),
     ),
     "calibration": JobKind(
         CalibrationRequest,
@@ -126,13 +155,59 @@ def loaded() -> None:
 def run_job(kind: str, request: dict[str, Any], settings: Settings) -> dict[str, Any]:
     """A job's result as JSON: exactly the synchronous endpoint's answer (jobs may solve up to
     ``max_job_time_limit_s``)."""
-    settings = settings.model_copy(
+    job, validated = _job(kind, request)
+    assert job.run is not None, f"{kind} jobs run in parts"
+    return job.answer(validated, job.run(validated, job_settings(settings))).model_dump(mode="json")
+
+
+def plan_parts(
+    kind: str, request: dict[str, Any], settings: Settings
+) -> tuple[dict[str, Any], list[tuple[Any, int]]]:
+    """A job run in parts, checked and cut up (:attr:`Fanout.plan`)."""
+    fanout, validated = _fanout(kind, request)
+    return fanout.plan(validated, job_settings(settings))
+
+
+def run_part(
+    kind: str, request: dict[str, Any], settings: Settings, context: dict[str, Any], spec: Any
+) -> dict[str, Any]:
+    """One part's result as JSON (:attr:`Fanout.run_part`)."""
+    fanout, validated = _fanout(kind, request)
+    return fanout.run_part(validated, job_settings(settings), context, spec)
+
+
+def merge_parts(
+    kind: str,
+    request: dict[str, Any],
+    settings: Settings,
+    context: dict[str, Any],
+    results: list[dict[str, Any]],
+    runtime_s: float,
+) -> dict[str, Any]:
+    """The job's result as JSON from its parts' (:attr:`Fanout.merge`)."""
+    fanout, validated = _fanout(kind, request)
+    answer = fanout.merge(validated, job_settings(settings), context, results, runtime_s)
+    return answer.model_dump(mode="json")
+
+
+def job_settings(settings: Settings) -> Settings:
+    """The settings a job runs with: it may solve up to ``max_job_time_limit_s`` and simulate
+    as long as it must."""
+    return settings.model_copy(
         update={
             "max_time_limit_s": settings.max_job_time_limit_s,
-            "max_sync_simulated_s": float("inf"),  # a job may simulate as long as it must
+            "max_sync_simulated_s": float("inf"),
             "max_sync_calibration_samples": sys.maxsize,
         }
     )
+
+
+def _job(kind: str, request: dict[str, Any]) -> tuple[JobKind[Any, Any], BaseModel]:
     job = JOB_KINDS[kind]
-    validated = job.request.model_validate(request)
-    return job.answer(validated, job.run(validated, settings)).model_dump(mode="json")
+    return job, job.request.model_validate(request)
+
+
+def _fanout(kind: str, request: dict[str, Any]) -> tuple[Fanout[Any], BaseModel]:
+    job, validated = _job(kind, request)
+    assert job.fanout is not None, f"{kind} jobs do not run in parts"
+    return job.fanout, validated

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Body, Header, Path, Query, Request, Response
@@ -14,7 +15,7 @@ from app.deps import SettingsDep, StoreDep
 from app.examples import PLAN_EXAMPLE
 from app.jobs.models import FINISHED, JobStatus
 from app.jobs.schemas import JobList, JobOut, JobSubmission, JobSummary
-from app.jobs.store import IdempotencyConflictError, JobStore, JobView
+from app.jobs.store import IdempotencyConflictError, JobStore, JobView, Progress
 from app.operations.kinds import JOB_KINDS
 from app.settings import Settings
 from core.exceptions import CoreError
@@ -42,7 +43,7 @@ def _validated(submission: JobSubmission, settings: Settings) -> BaseModel:
     return request
 
 
-def _summary(job: JobView) -> dict[str, Any]:
+def _summary(job: JobView, progress: Progress | None = None) -> dict[str, Any]:
     return {
         "id": job.id,
         "type": job.type,
@@ -51,21 +52,22 @@ def _summary(job: JobView) -> dict[str, Any]:
         "started_at": job.started_at,
         "finished_at": job.finished_at,
         "attempts": job.attempts,
+        "progress": None if progress is None else dataclasses.asdict(progress),
     }
 
 
-def _out(job: JobView) -> JobOut:
+def _out(job: JobView, progress: Progress | None = None) -> JobOut:
     # The stored result is JSON (times as text): read it back as JSON is read, not strictly.
     return JobOut.model_validate(
-        _summary(job) | {"result": job.result, "error": job.error}, strict=False
+        _summary(job, progress) | {"result": job.result, "error": job.error}, strict=False
     )
 
 
-def _get(store: JobStore, job_id: str) -> JobView:
+def _get(store: JobStore, job_id: str) -> tuple[JobView, Progress | None]:
     job = store.get(job_id)
     if job is None:
         raise HTTPException(404, f"no job {job_id}")
-    return job
+    return job, store.progress([job_id]).get(job_id)
 
 
 @router.post(
@@ -144,7 +146,10 @@ async def list_jobs(
 ) -> JobList:
     """The newest jobs first, without their results."""
     jobs = await asyncio.to_thread(store.recent, status, limit)
-    return JobList(jobs=[JobSummary.model_validate(_summary(job)) for job in jobs])
+    progress = await asyncio.to_thread(store.progress, [job.id for job in jobs])
+    return JobList(
+        jobs=[JobSummary.model_validate(_summary(job, progress.get(job.id))) for job in jobs]
+    )
 
 
 JobId = Annotated[str, Path(max_length=64, description="The job's id.")]
@@ -165,8 +170,8 @@ async def get_job(
 ) -> JobOut:
     """Its status and timestamps; its result when it succeeded, its error when it failed; with
     `include_request`, what was submitted (the plan viewer reopens a job's plan with it)."""
-    job = await asyncio.to_thread(_get, store, job_id)
-    out = _out(job)
+    job, progress = await asyncio.to_thread(_get, store, job_id)
+    out = _out(job, progress)
     return out.model_copy(update={"request": job.request}) if include_request else out
 
 
@@ -182,11 +187,11 @@ async def get_job(
 async def cancel_job(job_id: JobId, store: StoreDep) -> JobOut:
     """A queued job never runs; a running one is stopped (its worker process is terminated).
     A job that has already ended cannot be cancelled (409)."""
-    before = await asyncio.to_thread(_get, store, job_id)
+    before, _ = await asyncio.to_thread(_get, store, job_id)
     if before.status in FINISHED:
         raise HTTPException(409, f"job {job_id} has already ended ({before.status})")
     job = await asyncio.to_thread(store.cancel, job_id)
     if job is None:  # deleted meanwhile (its retention ran out)
         raise HTTPException(404, f"no job {job_id}")
-    # The runner watching it stops its worker process within a heartbeat.
-    return _out(job)
+    # The runner watching it stops its worker processes within a heartbeat.
+    return _out(job, await asyncio.to_thread(lambda: store.progress([job_id]).get(job_id)))

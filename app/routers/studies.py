@@ -11,7 +11,7 @@ from starlette.concurrency import run_in_threadpool
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import ELECTRIFICATION_EXAMPLE, SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
-from app.operations.electrification import merged_answer, run_study_part, study_parts
+from app.operations.electrification import merged_answer, plan_study, run_study_part
 from app.operations.studies import run_scenarios as scenarios
 from app.operations.studies import sweep_speeds as sweep
 from app.operations.telematics import with_history
@@ -100,25 +100,25 @@ async def study_electrification(
     electric and the depot's recharge. The routes are shared out over the server's workers.
     Larger studies run as jobs (type electrification)."""
     started = time.perf_counter()
-    parts, weather = await pool.run(
-        study_parts, request, settings, disconnected=http.is_disconnected
+    context, parts = await pool.run(
+        plan_study, request, settings, settings.workers, False, disconnected=http.is_disconnected
     )
     done = await asyncio.gather(
         *(
             pool.run(
-                run_study_part, request, settings, part, weather, disconnected=http.is_disconnected
+                run_study_part, request, settings, context, spec, disconnected=http.is_disconnected
             )
-            for part in parts
+            for spec, _ in parts
         )
     )
     runtime_s = time.perf_counter() - started
-    return await asyncio.to_thread(merged_answer, request, settings, list(done), weather, runtime_s)
+    return await asyncio.to_thread(merged_answer, request, settings, context, list(done), runtime_s)
 
 
 @router.post(
     "/electrification/from-csv",
     operation_id="electrificationStudyFromCsv",
-    summary="A study's routes from a telematics export (CSV)",
+    summary="A study's routes from a telematics export or GPS traces (CSV)",
     response_model_exclude_unset=True,  # the study as sent, ready to send on
 )
 async def electrification_study_from_csv(
@@ -137,7 +137,10 @@ async def electrification_study_from_csv(
             "(local HH:MM or HH:MM:SS) and optionally `delivery_kg`, `door_minutes`; each day "
             "of a route its rows together, first the departure from the route's depot (its "
             "`stop_id` the depot's id), then the stops in the order driven, then the return if "
-            "the export has it. Comma or semicolon between cells. UTF-8."
+            "the export has it. Or GPS traces, one row per fix: `route_id`, `date`, `time` "
+            "(local HH:MM[:SS]), `lat`, `lon`, each day's fixes together in time order: the "
+            "day starts at the last fix at the depot (within 150 m), a stop is 2 min or more "
+            "within 50 m, its service the dwell. Comma or semicolon between cells. UTF-8."
         ),
     ],
 ) -> ElectrificationRequest:

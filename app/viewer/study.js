@@ -4,7 +4,7 @@
 // Uses the page's api(), el() and $() (viewer.js).
 "use strict";
 
-const study = { answer: null, plot: null };
+const study = { answer: null, plot: null, job: null };
 
 async function loadStudyExample() {
   const doc = await api("GET", "/openapi.json");
@@ -54,6 +54,8 @@ async function runStudy() {
       type: "electrification", request: { ...request, include_days: true },
     });
     if (!submitted.ok) { studyStatus(problemText(submitted)); return; }
+    study.job = submitted.data.id;
+    $("study-cancel").hidden = false;
     const done = await waitForJob(submitted.data.id);
     if (done.status !== "succeeded") {
       studyStatus(`Study job ${done.id}: ${done.status}${done.error ? `, ${done.error.detail}` : ""}`);
@@ -64,7 +66,22 @@ async function runStudy() {
     drawStudy();
   } finally {
     $("study-run").disabled = false;
+    $("study-cancel").hidden = true;
+    study.job = null;
   }
+}
+
+async function cancelStudy() {
+  // The job's parts stop on every worker; waitForJob then sees it cancelled.
+  if (study.job) await api("DELETE", `/v1/jobs/${encodeURIComponent(study.job)}`);
+}
+
+function progressText(job) {
+  const p = job.progress;
+  if (!p || !p.total) return `${job.status}…`;
+  const share = Math.floor((100 * p.done) / p.total);
+  return `${job.status}: ${p.done.toLocaleString("en")} of ${p.total.toLocaleString("en")} ` +
+    `route-days × candidates (${share} %, ${p.parts_done} of ${p.parts_total} parts)…`;
 }
 
 function problemText(answer) {
@@ -79,7 +96,7 @@ async function waitForJob(jobId) {
     if (!answer.ok) return { id: jobId, status: "failed", error: { detail: problemText(answer) } };
     const job = answer.data;
     if (["succeeded", "failed", "cancelled"].includes(job.status)) return job;
-    studyStatus(`Study job ${job.id}: ${job.status}…`);
+    studyStatus(`Study job ${job.id}: ${progressText(job)}`);
     await new Promise((resolve) => setTimeout(resolve, 1000));
   }
 }
@@ -160,6 +177,7 @@ function drawCoverage(routes, candidateId) {
 document.addEventListener("DOMContentLoaded", () => {
   $("study-example").addEventListener("click", () => loadStudyExample().catch((error) => studyStatus(`Unexpected: ${error.message}`)));
   $("study-run").addEventListener("click", () => runStudy().catch((error) => studyStatus(`Unexpected: ${error.message}`)));
+  $("study-cancel").addEventListener("click", () => cancelStudy().catch((error) => studyStatus(`Unexpected: ${error.message}`)));
   $("study-csv").addEventListener("change", () => readExport().catch((error) => studyStatus(`Unexpected: ${error.message}`)));
 });
 

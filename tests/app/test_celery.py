@@ -21,7 +21,14 @@ import redis
 from app.examples import CHARGING_PLAN_EXAMPLE, PLAN_EXAMPLE
 from benchmarks.common import Server
 from tests.app.serving import children, cpu_ticks, long_plan
-from tests.app.test_jobs import assert_spaced, submit, wait_for
+from tests.app.test_jobs import (
+    BIG_STUDY,
+    assert_spaced,
+    running_with_parts_done,
+    submit,
+    wait_for,
+    without_clock,
+)
 from tests.app.test_reproducible import without_timing
 from tests.router_stub import DownRouter
 
@@ -44,6 +51,8 @@ def own_services() -> Iterator[dict[str, str]]:
         "COLDROUTE_JOB_HEARTBEAT_S": "0.5",
         "COLDROUTE_JOB_STALE_AFTER_S": "3",
         "COLDROUTE_WORKERS": "1",
+        "COLDROUTE_JOB_PART_ROUTE_DAYS": "100",  # a study job in a part per route
+        "COLDROUTE_MAX_SYNC_ROUTE_DAYS": "100000",  # the local answer to compare with
     }
     try:
         yield env
@@ -150,6 +159,59 @@ def test_a_celery_job_answers_byte_for_byte_what_the_endpoint_answers(server, wo
     direct = httpx.post(f"{server.url}/v1/plans", json=CHARGING_PLAN_EXAMPLE, timeout=60).json()
     assert done["status"] == "succeeded"
     assert without_timing(done["result"]) == without_timing(direct)
+
+
+def part_runners(env: dict[str, str], job_id: str) -> dict[int, tuple[str, str]]:
+    """Each part of a job: its status and the worker that holds or did it."""
+    schema = env["COLDROUTE_DATABASE_URL"].rsplit("search_path%3D", 1)[1]
+    with psycopg.connect(POSTGRES, options=f"-csearch_path={schema}") as connection:
+        rows = connection.execute(
+            'SELECT "index", status, runner FROM job_parts WHERE job_id = %s', (job_id,)
+        )
+        return {index: (status, (runner or "").split("@")[0]) for index, status, runner in rows}
+
+
+@pytest.fixture(scope="module")
+def local_study(server):
+    """The study answered by the server's own pool (the synchronous endpoint)."""
+    answer = httpx.post(f"{server.url}/v1/studies/electrification", json=BIG_STUDY, timeout=300)
+    assert answer.status_code == 200, answer.text
+    return answer.json()
+
+
+def test_a_study_job_is_shared_out_over_the_workers_and_equals_the_local_answer(
+    services, server, workers, local_study
+):
+    job_id = submit(server.url, {"type": "electrification", "request": BIG_STUDY}).json()["id"]
+    done = wait_for(server.url, job_id, timeout=300)
+    assert done["status"] == "succeeded", done
+    assert done["progress"]["parts_total"] == len(BIG_STUDY["routes"])  # a part per route
+    by = part_runners(services, job_id)
+    assert {status for status, _ in by.values()} == {"done"}
+    assert {worker for _, worker in by.values()} == {"w1", "w2"}  # both took parts
+    assert without_clock(done["result"]) == without_clock(local_study)
+
+
+def test_a_worker_killed_mid_study_loses_nothing(services, server, workers, local_study):
+    """Two more workers; one is killed while it runs a part: that part is redone elsewhere,
+    the parts done are kept, and the answer is the local one."""
+    extra = [Worker(services, name) for name in ("w3", "w4")]
+    try:
+        ready_within(server.url, 30)
+        job_id = submit(server.url, {"type": "electrification", "request": BIG_STUDY}).json()["id"]
+        running_with_parts_done(server.url, job_id, timeout_s=120)
+        deadline = time.monotonic() + 60
+        while ("running", "w3") not in part_runners(services, job_id).values():
+            assert time.monotonic() < deadline, part_runners(services, job_id)
+            time.sleep(0.05)
+        extra[0].kill()
+        done = wait_for(server.url, job_id, timeout=300)
+        assert done["status"] == "succeeded", done
+        assert done["progress"]["parts_done"] == done["progress"]["parts_total"]
+        assert without_clock(done["result"]) == without_clock(local_study)
+    finally:
+        for worker in extra:
+            worker.stop()
 
 
 def test_a_worker_killed_mid_job_leaves_it_to_another(server, workers):

@@ -36,6 +36,7 @@ FAST = {
     "COLDROUTE_JOB_SLOTS": "1",
     "COLDROUTE_JOB_HEARTBEAT_S": "0.5",
     "COLDROUTE_JOB_STALE_AFTER_S": "2",
+    "COLDROUTE_JOB_PART_ROUTE_DAYS": "100",  # a study job in many parts
 }
 
 
@@ -358,17 +359,123 @@ def test_finished_jobs_expire_after_the_retention():
         short.close()
 
 
+def fleet_study(copies: int, weekdays: list[str], candidates: int) -> dict:
+    """The example study's routes ``copies`` times (their own ids), driven on ``weekdays``,
+    with its first ``candidates``."""
+    study = copy.deepcopy(ELECTRIFICATION_EXAMPLE)
+    study["routes"] = [
+        route | {"id": f"{route['id']}-{k}", "days": {"weekdays": weekdays}}
+        for k in range(copies)
+        for route in copy.deepcopy(ELECTRIFICATION_EXAMPLE["routes"])
+    ]
+    study["candidates"] = study["candidates"][:candidates]
+    return study
+
+
+#: A study of some seconds on two workers: 8 routes, 6 days a week, 2 candidates.
+BIG_STUDY = fleet_study(4, ["mon", "tue", "wed", "thu", "fri", "sat"], 2)
+
+
+def without_clock(answer: dict) -> dict:
+    return {k: v for k, v in answer.items() if k not in ("runtime_s", "route_days_per_s")}
+
+
 def test_an_electrification_job_answers_what_the_endpoint_answers(server):
-    """The study as a job in the worker pool: the same routes, days and verdicts as the
-    synchronous answer (its clock aside)."""
-    sync = httpx.post(
-        f"{server.url}/v1/studies/electrification", json=ELECTRIFICATION_EXAMPLE, timeout=120
-    )
+    """The study as a job, cut into a part per route (each of about 100 route-days) shared out
+    over the workers: the same routes, days and verdicts as the synchronous answer, which cuts
+    it in two (one part per worker) — its clock aside."""
+    study = fleet_study(2, ["mon", "wed", "fri"], 1)
+    sync = httpx.post(f"{server.url}/v1/studies/electrification", json=study, timeout=120)
     assert sync.status_code == 200, sync.text
-    job_id = submit(server.url, {"type": "electrification", "request": ELECTRIFICATION_EXAMPLE})
-    done = wait_for(server.url, job_id.json()["id"], timeout=120)
+    job_id = submit(server.url, {"type": "electrification", "request": study}).json()["id"]
+    done = wait_for(server.url, job_id, timeout=120)
     assert done["status"] == "succeeded", done
-    timing = ("runtime_s", "route_days_per_s")
-    assert {k: v for k, v in done["result"].items() if k not in timing} == {
-        k: v for k, v in sync.json().items() if k not in timing
+    route_days = sync.json()["route_days"]
+    assert done["progress"] == {
+        "done": route_days,
+        "total": route_days,
+        "parts_done": 4,
+        "parts_total": 4,
     }
+    assert without_clock(done["result"]) == without_clock(sync.json())
+    listed = httpx.get(f"{server.url}/v1/jobs?limit=5").json()["jobs"]
+    assert next(j for j in listed if j["id"] == job_id)["progress"]["parts_done"] == 4
+    plan_job = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()
+    assert plan_job["progress"] is None  # not run in parts
+
+
+def running_with_parts_done(url: str, job_id: str, timeout_s: float = 60) -> dict:
+    """The job once it runs and some, not all, of its parts are done."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        job = httpx.get(f"{url}/v1/jobs/{job_id}", timeout=10).json()
+        progress = job["progress"]
+        if job["status"] == "running" and progress and progress["parts_done"] > 0:
+            assert progress["parts_done"] < progress["parts_total"], "finished too soon to test"
+            return job
+        time.sleep(0.1)
+    raise AssertionError(f"job {job_id}: no part done within {timeout_s} s")
+
+
+def test_a_study_job_loses_nothing_when_a_worker_is_killed(server):
+    """A worker process killed mid-part: that part is redone (not the job, not the parts
+    done), and the answer is that of a run nobody disturbed."""
+    calm = submit(server.url, {"type": "electrification", "request": BIG_STUDY}).json()["id"]
+    calm_done = wait_for(server.url, calm, timeout=180)
+    assert calm_done["status"] == "succeeded", calm_done
+    wait_quiet(server.process.pid)
+    job_id = submit(server.url, {"type": "electrification", "request": BIG_STUDY}).json()["id"]
+    before = running_with_parts_done(server.url, job_id)["progress"]
+    working = busiest_child(server.process.pid)
+    assert working is not None, "no worker is simulating"
+    os.kill(working, signal.SIGKILL)
+    done = wait_for(server.url, job_id, timeout=180)
+    assert done["status"] == "succeeded" and done["attempts"] == 1, done
+    assert done["progress"]["parts_done"] == done["progress"]["parts_total"]
+    assert done["progress"]["parts_done"] > before["parts_done"]
+    assert without_clock(done["result"]) == without_clock(calm_done["result"])
+
+
+def test_a_running_study_job_is_cancelled_with_its_parts(server):
+    wait_quiet(server.process.pid)
+    job_id = submit(server.url, {"type": "electrification", "request": BIG_STUDY}).json()["id"]
+    running_with_parts_done(server.url, job_id)
+    cancelled = httpx.delete(f"{server.url}/v1/jobs/{job_id}").json()
+    assert cancelled["status"] == "cancelled"
+    wait_quiet(server.process.pid, timeout_s=10)  # every part's worker was stopped
+    left = httpx.get(f"{server.url}/v1/jobs/{job_id}").json()
+    time.sleep(1.5)
+    assert httpx.get(f"{server.url}/v1/jobs/{job_id}").json()["progress"] == left["progress"]
+    progress = left["progress"]
+    assert left["result"] is None and progress["parts_done"] < progress["parts_total"]
+
+
+def test_a_study_job_resumes_after_the_server_is_killed_keeping_its_parts():
+    """SIGKILL of the server mid-study; the next server on the same database runs the job
+    again from the parts that were done (their count never goes back) to the same answer."""
+    with tempfile.TemporaryDirectory() as folder:
+        first = Server(FAST, database_dir=Path(folder)).start()
+        calm = submit(first.url, {"type": "electrification", "request": BIG_STUDY}).json()["id"]
+        calm_done = wait_for(first.url, calm, timeout=180)
+        job_id = submit(first.url, {"type": "electrification", "request": BIG_STUDY}).json()["id"]
+        running_with_parts_done(first.url, job_id)
+        first.process.send_signal(signal.SIGKILL)
+        first.process.wait()
+        second = Server(FAST, database_dir=Path(folder)).start()
+        try:
+            resumed = httpx.get(f"{second.url}/v1/jobs/{job_id}").json()["progress"]
+            assert resumed["parts_done"] > 0  # what the first server finished is kept
+            seen = [resumed["parts_done"]]
+            deadline = time.monotonic() + 180
+            while (job := httpx.get(f"{second.url}/v1/jobs/{job_id}").json())["status"] in (
+                "queued",
+                "running",
+            ):
+                seen.append(job["progress"]["parts_done"])
+                assert time.monotonic() < deadline
+                time.sleep(0.2)
+            assert seen == sorted(seen), seen  # never counted down
+            assert job["status"] == "succeeded" and job["attempts"] == 2, job
+            assert without_clock(job["result"]) == without_clock(calm_done["result"])
+        finally:
+            second.close()

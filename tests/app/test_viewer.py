@@ -22,6 +22,7 @@ from app.settings import Settings
 from benchmarks.common import Server
 from tests.app.invariants import CheckedClient
 from tests.app.test_browser import offline_tab
+from tests.app.test_jobs import BIG_STUDY
 from tests.app.test_roads import monaco_plan
 
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts" / "viewer"
@@ -692,4 +693,24 @@ def test_a_telematics_export_becomes_the_studys_days_in_the_viewer(server, page,
         "2 route-days studied", timeout=120_000
     )
     assert tab.get_by_test_id("study-heatmap").locator(".day").count() == 2
+    assert outside == []
+
+
+def test_a_running_study_shows_its_progress_and_is_cancelled_from_the_viewer(server, page):
+    tab, outside = page
+    tab.goto(f"{server.url}/viewer")
+    tab.get_by_test_id("api-key").fill(KEY)
+    tab.get_by_test_id("api-key").dispatch_event("change")
+    tab.get_by_test_id("study-json").fill(json.dumps(BIG_STUDY))  # 3 parts of ~2,000
+    tab.get_by_test_id("study-run").click()
+    status = tab.get_by_test_id("study-status")
+    expect(status).to_contain_text(
+        re.compile(r"running: [\d,]+ of [\d,]+ route-days"), timeout=60_000
+    )
+    expect(status).to_contain_text(re.compile(r"[12] of 3 parts"), timeout=60_000)
+    shot(tab, "18-electrification-progress")
+    tab.get_by_test_id("study-cancel").click()
+    expect(status).to_contain_text("cancelled", timeout=30_000)
+    expect(tab.get_by_test_id("study-cancel")).to_be_hidden()
+    expect(tab.get_by_test_id("study-run")).to_be_enabled()
     assert outside == []

@@ -37,6 +37,7 @@ from core.planning.electrification.model import (
     ElectrificationProblem,
     ElectrificationResult,
     RouteOutcome,
+    StudyFields,
     WeatherSourceName,
     Weekdays,
 )
@@ -89,7 +90,7 @@ def _as_route(route: DrivenRoute) -> Driven:
     return route.start_time, route.stops
 
 
-def route_days(problem: ElectrificationProblem) -> int:
+def route_days(problem: StudyFields) -> int:
     """How many route-days the study simulates (each for every candidate)."""
     return sum(
         len(route_dates(r, problem.year, f"routes[{i}].days")) for i, r in enumerate(problem.routes)
