@@ -9,6 +9,13 @@ the export has it, the return to the depot (its ``arrival``). Columns: ``route_i
 HH:MM:SS, within the day), and optionally ``delivery_kg`` and ``door_minutes`` (default: the
 stop's service, at most a minute). A bad cell is a 422 naming ``history[<line>].<column>``,
 the line of the file (its header is line 1).
+
+Or GPS traces — one row per fix: ``route_id``, ``date``, ``time`` (local HH:MM[:SS]), ``lat``,
+``lon`` — each day's fixes together and in time order. The day starts when the van leaves the
+depot (its last fix within :data:`AT_DEPOT_M`), ends when it is back, and a stop is where it
+stays within :data:`DWELL_RADIUS_M` for :data:`MIN_DWELL_S` or longer (the dwell detection
+of telematics "stop" reports, e.g. Geotab's trips and stops): its place the mean of those
+fixes, its service the dwell.
 """
 
 from __future__ import annotations
@@ -18,11 +25,24 @@ import datetime as dt
 import re
 from typing import Any
 
+import numpy as np
+from pydantic import ValidationError
+
 from app.operations.cells import delimiter_of, number
 from core.exceptions import InvalidParameterError
+from core.params import Location
+from core.routing.geo import metres_from
 
 REQUIRED = ("route_id", "date", "stop_id", "lat", "lon", "arrival", "departure")
 OPTIONAL = ("delivery_kg", "door_minutes")
+#: The columns of GPS traces: one row per fix.
+TRACE = ("route_id", "date", "time", "lat", "lon")
+#: A van within this distance of its depot is at the depot [m].
+AT_DEPOT_M = 150.0
+#: A stop: the van stays within this distance of where it stopped [m] …
+DWELL_RADIUS_M = 50.0
+#: … for at least this long [s].
+MIN_DWELL_S = 120.0
 _CLOCK = re.compile(r"([01][0-9]|2[0-3]):([0-5][0-9])(?::([0-5][0-9]))?")
 #: Door minutes when the export has none: a minute, or the whole service when shorter [s].
 DEFAULT_DOOR_S = 60.0
@@ -70,18 +90,22 @@ def _clock(seconds: int) -> str:
     return f"{seconds // 3600:02d}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
 
 
-def _lines(text: str) -> list[_Line]:
+def _lines(text: str) -> tuple[list[_Line], bool]:
+    """The rows of the file, and whether it is GPS traces (its header has ``time`` and no
+    ``stop_id``) rather than stops."""
     rows = text.lstrip("\ufeff").splitlines()
     if not rows or not rows[0].strip():
         raise InvalidParameterError("the CSV has no header row", "history")
     delimiter = delimiter_of(rows[0])
     table = list(csv.reader(rows, delimiter=delimiter))
     header = [cell.strip() for cell in table[0]]
-    missing = [name for name in REQUIRED if name not in header]
+    traces = "time" in header and "stop_id" not in header
+    missing = [name for name in (TRACE if traces else REQUIRED) if name not in header]
     if missing:
         raise InvalidParameterError(
             f"the header has no column {missing[0]!r}; the columns are "
-            f"{', '.join(REQUIRED)} and optionally {', '.join(OPTIONAL)}",
+            f"{', '.join(REQUIRED)} and optionally {', '.join(OPTIONAL)} (one row per stop), "
+            f"or {', '.join(TRACE)} (GPS traces: one row per fix)",
             "history",
         )
     out = []
@@ -94,7 +118,7 @@ def _lines(text: str) -> list[_Line]:
                 f"history[{index}]",
             )
         out.append(_Line(index, dict(zip(header, row, strict=True)), delimiter))
-    return out
+    return out, traces
 
 
 class _Day:
@@ -174,33 +198,126 @@ def with_history(body: dict[str, Any], text: str) -> dict[str, Any]:
                     f"{name} come from the file: leave them out", f"routes[{k}].{name}"
                 )
         by_id[route["id"]] = k
+    lines, traces = _lines(text)
     days: list[list[dict[str, Any]]] = [[] for _ in routes]
-    seen: set[tuple[str, dt.date]] = set()
-    day: _Day | None = None
-    key: tuple[str, dt.date] | None = None
-    last: _Line | None = None
-    for row in _lines(text):
-        route_id = row.text("route_id")
-        if route_id not in by_id:
-            raise row.error("route_id", f"no route of the study has the id {route_id[:64]!r}")
-        here = (route_id, row.date())
-        if here != key:
-            if day is not None and key is not None and last is not None:
-                days[by_id[key[0]]].append(day.driven(last))
-            if here in seen:
-                raise row.error("date", f"the rows of {route_id} on {here[1]} are not together")
-            previous = days[by_id[route_id]]
-            if previous and previous[-1]["date"] > here[1].isoformat():
-                raise row.error("date", f"{here[1]} comes after a later day of {route_id}")
-            seen.add(here)
-            day, key = _Day(row, str(routes[by_id[route_id]]["depot"].get("id"))), here
-        else:
-            assert day is not None
-            day.add(row)
-        last = row
-    if day is not None and key is not None and last is not None:
-        days[by_id[key[0]]].append(day.driven(last))
+    for route_id, group in _days(lines, by_id):
+        depot = routes[by_id[route_id]]["depot"]
+        if traces:
+            try:
+                Location.model_validate({"lat": depot.get("lat"), "lon": depot.get("lon")})
+            except ValidationError:
+                raise InvalidParameterError(
+                    "a depot needs its lat (-90..90) and lon (-180..180) to find it in the traces",
+                    f"routes[{by_id[route_id]}].depot",
+                ) from None
+        day = _traced(route_id, group, depot) if traces else _visited(group, depot)
+        days[by_id[route_id]].append(day)
     for k, route_days in enumerate(days):
         if not route_days:
             raise InvalidParameterError("the file has no day of this route", f"routes[{k}]")
     return body | {"routes": [r | {"days": d} for r, d in zip(routes, days, strict=True)]}
+
+
+def _days(lines: list[_Line], by_id: dict[str, int]) -> list[tuple[str, list[_Line]]]:
+    """The rows of each route's day, in the file's order: a day's rows together, a route's
+    days in date order."""
+    out: list[tuple[str, list[_Line]]] = []
+    seen: set[tuple[str, dt.date]] = set()
+    last: dict[str, dt.date] = {}
+    key: tuple[str, dt.date] | None = None
+    for row in lines:
+        route_id = row.text("route_id")
+        if route_id not in by_id:
+            raise row.error("route_id", f"no route of the study has the id {route_id[:64]!r}")
+        here = (route_id, row.date())
+        if here == key:
+            out[-1][1].append(row)
+            continue
+        if here in seen:
+            raise row.error("date", f"the rows of {route_id} on {here[1]} are not together")
+        if route_id in last and last[route_id] > here[1]:
+            raise row.error("date", f"{here[1]} comes after a later day of {route_id}")
+        seen.add(here)
+        last[route_id], key = here[1], here
+        out.append((route_id, [row]))
+    return out
+
+
+def _visited(group: list[_Line], depot: dict[str, Any]) -> dict[str, Any]:
+    """A day of one row per stop visited."""
+    day = _Day(group[0], str(depot.get("id")))
+    for row in group[1:]:
+        day.add(row)
+    return day.driven(group[-1])
+
+
+def _traced(route_id: str, group: list[_Line], depot: dict[str, Any]) -> dict[str, Any]:
+    """A day of GPS fixes: its departure from the depot and its stops (dwells)."""
+    times = np.array([row.seconds("time") for row in group], dtype=float)
+    for k in range(1, len(group)):
+        if times[k] <= times[k - 1]:
+            raise group[k].error(
+                "time", f"time {group[k].text('time')} is not after the fix before"
+            )
+    lat = np.array([row.number("lat", -90, 90) for row in group])
+    lon = np.array([row.number("lon", -180, 180) for row in group])
+    place = Location.model_validate({"lat": depot.get("lat"), "lon": depot.get("lon")})
+    from_depot_m = metres_from(place.lat, place.lon, lat, lon)
+    away = np.flatnonzero(from_depot_m > AT_DEPOT_M)
+    if from_depot_m[0] > AT_DEPOT_M or away.size == 0:
+        raise group[0].error("lat", "a day's trace begins at the depot, then leaves it")
+    leave = int(away[0])
+    back = leave + int(np.argmax(from_depot_m[leave:] <= AT_DEPOT_M))
+    end = back if from_depot_m[back] <= AT_DEPOT_M else len(group)
+    stops = _dwells(route_id, group[0].date(), times[leave:end], lat[leave:end], lon[leave:end])
+    if not stops:
+        raise group[0].error(
+            "time",
+            f"the trace of {group[0].date()} has no stop (a stop is {MIN_DWELL_S / 60:g} min "
+            f"or more within {DWELL_RADIUS_M:g} m)",
+        )
+    return {
+        "date": group[0].date().isoformat(),
+        "start_time": _clock(int(times[leave - 1]))[:5],
+        "stops": stops,
+    }
+
+
+def _dwells(
+    route_id: str, date: dt.date, times: np.ndarray, lat: np.ndarray, lon: np.ndarray
+) -> list[dict[str, Any]]:
+    """The stops among fixes away from the depot: runs of fixes within
+    :data:`DWELL_RADIUS_M` of the run's first for :data:`MIN_DWELL_S` or longer."""
+    stops: list[dict[str, Any]] = []
+    i = 0
+    while i < len(times):
+        j = _last_within(i, lat, lon)
+        if times[j] - times[i] >= MIN_DWELL_S:
+            service_s = float(times[j] - times[i])
+            stops.append(
+                {
+                    "id": f"{route_id}-{date.isoformat()}-{len(stops) + 1}"[:64],
+                    "lat": float(lat[i : j + 1].mean()),
+                    "lon": float(lon[i : j + 1].mean()),
+                    "service_time_s": service_s,
+                    "door_open_s": min(DEFAULT_DOOR_S, service_s),
+                    "delivery_kg": 0.0,
+                }
+            )
+            i = j + 1
+        else:
+            i += 1
+    return stops
+
+
+def _last_within(i: int, lat: np.ndarray, lon: np.ndarray, chunk: int = 64) -> int:
+    """The last fix of the run from fix ``i`` that stays within :data:`DWELL_RADIUS_M` of it
+    (looked at a chunk at a time: a drive ends the run at once, a long dwell in a few)."""
+    start = i + 1
+    while start < len(lat):
+        near = metres_from(lat[i], lon[i], lat[start : start + chunk], lon[start : start + chunk])
+        out = np.flatnonzero(near > DWELL_RADIUS_M)
+        if out.size:
+            return start + int(out[0]) - 1
+        start += chunk
+    return len(lat) - 1

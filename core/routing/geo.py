@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -89,11 +89,29 @@ def great_circle_m(lat: FloatArray, lon: FloatArray) -> FloatArray:
     lat, lon
         Latitudes and longitudes [°].
     """
-    phi, lam = np.radians(lat), np.radians(lon)
-    dphi = phi[:, None] - phi[None, :]
-    dlam = lam[:, None] - lam[None, :]
-    h = np.sin(dphi / 2) ** 2 + np.cos(phi)[:, None] * np.cos(phi)[None, :] * np.sin(dlam / 2) ** 2
-    return 2 * EARTH_RADIUS_M * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0)))
+    lat, lon = np.asarray(lat, dtype=float), np.asarray(lon, dtype=float)
+    return _haversine_m(lat[:, None], lon[:, None], lat[None, :], lon[None, :])
+
+
+def metres_from(lat0: float, lon0: float, lat: FloatArray, lon: FloatArray) -> FloatArray:
+    """Great-circle distance from one point to each of ``lat``, ``lon`` [m] (haversine).
+
+    Parameters
+    ----------
+    lat0, lon0
+        The point [°].
+    lat, lon
+        The others [°].
+    """
+    return _haversine_m(np.float64(lat0), np.float64(lon0), np.asarray(lat), np.asarray(lon))
+
+
+def _haversine_m(lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> FloatArray:
+    """The haversine formula on broadcast arrays of degrees, on the mean Earth radius [m]."""
+    phi1, phi2 = np.radians(lat1), np.radians(lat2)
+    dphi, dlam = phi2 - phi1, np.radians(lon2) - np.radians(lon1)
+    h = np.sin(dphi / 2) ** 2 + np.cos(phi1) * np.cos(phi2) * np.sin(dlam / 2) ** 2
+    return np.asarray(2 * EARTH_RADIUS_M * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0))))
 
 
 def street_type_by_length(distance_m: FloatArray) -> NDArray[np.int_]:

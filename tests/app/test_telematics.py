@@ -98,3 +98,98 @@ def test_a_header_without_a_column_and_a_study_with_days_of_its_own_are_named():
     refused = send(ROWS, study=own)
     assert refused.status_code == 422
     assert refused.json()["errors"][0]["field"] == "routes[0].days"
+
+
+# GPS traces: a fix every 30 s. The van leaves the depot at 07:00, stops at Billa 07:20–07:29
+# and at Spar 07:41–07:48:30, halts a minute at a light on the way back (not a stop), and is
+# back at 08:10, then parked.
+BILLA, SPAR = (48.2006, 16.3862), (48.1925, 16.3671)
+LIGHT = (48.1800, 16.3900)
+
+
+def _clock(seconds: float) -> str:
+    seconds = int(seconds)
+    return f"{seconds // 3600:02d}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
+
+
+def _drive(a, b, t0: float, t1: float) -> list[tuple[float, float, float]]:
+    """Fixes every 30 s strictly between leaving ``a`` at ``t0`` and reaching ``b`` at ``t1``."""
+    steps = int((t1 - t0) // 30)
+    return [
+        (t0 + 30 * k, a[0] + (b[0] - a[0]) * k / steps, a[1] + (b[1] - a[1]) * k / steps)
+        for k in range(1, steps)
+    ]
+
+
+def _stay(place, t0: float, t1: float, jitter_deg: float = 0.00004):
+    """Fixes every 30 s from ``t0`` to ``t1`` at ``place``, a few metres of GPS noise."""
+    n = int((t1 - t0) // 30)
+    return [
+        (t0 + 30 * k, place[0] + jitter_deg * (-1) ** k, place[1] - jitter_deg * (-1) ** k)
+        for k in range(n + 1)
+    ]
+
+
+def _h(hours: int, minutes: float) -> float:
+    return hours * 3600 + minutes * 60
+
+
+DEPOT_AT = (DEPOT["lat"], DEPOT["lon"])
+FIXES = [
+    *_stay(DEPOT_AT, _h(6, 50), _h(7, 0)),
+    *_drive(DEPOT_AT, BILLA, _h(7, 0), _h(7, 20)),
+    *_stay(BILLA, _h(7, 20), _h(7, 29)),
+    *_drive(BILLA, SPAR, _h(7, 29), _h(7, 41)),
+    *_stay(SPAR, _h(7, 41), _h(7, 48.5)),
+    *_drive(SPAR, LIGHT, _h(7, 48.5), _h(7, 58)),
+    *_stay(LIGHT, _h(7, 58), _h(7, 59)),
+    *_drive(LIGHT, DEPOT_AT, _h(7, 59), _h(8, 10)),
+    *_stay(DEPOT_AT, _h(8, 10), _h(8, 30)),
+]
+TRACE_HEADER = "route_id,date,time,lat,lon"
+TRACE = [f"tour-1,2026-07-14,{_clock(t)},{lat:.6f},{lon:.6f}" for t, lat, lon in FIXES] + [
+    f"tour-2,2026-07-14,{_clock(t + 3600)},{lat:.6f},{lon:.6f}" for t, lat, lon in FIXES
+]
+
+
+def test_gps_traces_become_the_days_stops_where_the_van_dwelt():
+    response = send(TRACE, header=TRACE_HEADER)
+    assert response.status_code == 200, response.text
+    first, second = response.json()["routes"]
+    (day,) = first["days"]
+    assert day["start_time"] == "07:00"  # the last fix at the depot
+    billa, spar = day["stops"]  # the minute at the light is no stop
+    # the dwell from its first fix to its last within 50 m (hand count: 07:20–07:29, …)
+    assert billa["service_time_s"] == 540 and spar["service_time_s"] == 450
+    for stop, place in ((billa, BILLA), (spar, SPAR)):
+        assert abs(stop["lat"] - place[0]) < 1e-4 and abs(stop["lon"] - place[1]) < 1e-4
+    assert billa["id"] == "tour-1-2026-07-14-1" and billa["door_open_s"] == 60
+    assert second["days"][0]["start_time"] == "08:00"
+    answer = app_client().post("/v1/studies/electrification", json=response.json())
+    assert answer.status_code == 200, answer.text
+
+
+@pytest.mark.parametrize(
+    ("rows", "field", "words"),
+    [
+        ([TRACE[0], TRACE[2], TRACE[1]], "history[4].time", "not after the fix before"),
+        (TRACE[25 : len(FIXES)], "history[2].lat", "begins at the depot"),
+        (TRACE[:50], "history[2].time", "has no stop"),  # it leaves, never stops
+        ([TRACE[0], "tour-1,2026-07-14,06:51:00,95.0,16.42"], "history[3].lat", "within -90..90"),
+        ([TRACE[0], TRACE[1].replace(":", "h", 1)], "history[3].time", "not a time"),
+    ],
+)
+def test_a_bad_trace_names_the_line_and_the_column(rows, field, words):
+    response = send(rows, study={**STUDY, "routes": STUDY["routes"][:1]}, header=TRACE_HEADER)
+    assert response.status_code == 422, response.text
+    error = response.json()["errors"][0]
+    assert error["field"] == field and words in error["message"], error
+
+
+def test_traces_need_their_depot_and_their_columns():
+    study = {**STUDY, "routes": [{"id": "tour-1", "depot": {"id": "depot", "lat": 123}}]}
+    response = send(TRACE[: len(FIXES)], study=study, header=TRACE_HEADER)
+    assert response.status_code == 422
+    assert response.json()["errors"][0]["field"] == "routes[0].depot"
+    missing = send(TRACE, header="route_id,date,time,lat")
+    assert missing.status_code == 422 and "GPS traces" in missing.json()["detail"]
