@@ -113,9 +113,10 @@ async def create_job(
     the job and answers at once with its id; `GET /v1/jobs/{id}` tells its state and, when it
     has succeeded, its result — exactly what the synchronous endpoint returns."""
     request = _validated(submission, settings)
-    time_limit_s = min(
-        JOB_KINDS[submission.type].time_limit_s(request), settings.max_job_time_limit_s
-    )
+    kind = JOB_KINDS[submission.type]
+    time_limit_s = kind.time_limit_s(request)
+    if kind.fanout is None:  # a solver's budget is capped; a study's is its work (route-days)
+        time_limit_s = min(time_limit_s, settings.max_job_time_limit_s)
     try:
         job, new = await asyncio.to_thread(
             store.create,
