@@ -13,13 +13,12 @@ import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from pathlib import Path
 from typing import Any
 
 import httpx
 import numpy as np
 
-from benchmarks.common import Server, celery_cluster, print_table
+from benchmarks.common import Server, celery_cluster, children, print_table, rss_mib
 from core.params import PRESETS, Depot, Stop
 from core.planning.electrification.model import DrivenRoute
 from core.routing.geo import DETOUR_FACTOR
@@ -112,33 +111,6 @@ def run_job(url: str, study: dict[str, Any]) -> tuple[float, dict[str, Any]]:
     return wall_s, dict(done["result"])
 
 
-def _tree(pid: int) -> list[int]:
-    """``pid`` and its descendants (Linux /proc)."""
-    parents: dict[int, int] = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                stat = (entry / "stat").read_text()
-            except OSError:
-                continue
-            parents[int(entry.name)] = int(stat.rsplit(")", 1)[1].split()[1])
-    found, frontier = [pid], [pid]
-    while frontier:
-        frontier = [child for child, parent in parents.items() if parent in frontier]
-        found += frontier
-    return found
-
-
-def _rss_mb(pid: int) -> float:
-    try:
-        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
-    except OSError:
-        pass
-    return 0.0
-
-
 @contextmanager
 def peak_rss(pid: int) -> Iterator[dict[str, float]]:
     """The peak resident memory of the server ``pid`` and of its largest worker [MB], sampled
@@ -148,10 +120,9 @@ def peak_rss(pid: int) -> Iterator[dict[str, float]]:
 
     def sample() -> None:
         while not stop.wait(0.1):
-            tree = _tree(pid)
-            peaks["server_mb"] = max(peaks["server_mb"], _rss_mb(pid))
-            workers = [_rss_mb(child) for child in tree[1:]]
-            peaks["worker_mb"] = max([peaks["worker_mb"], *workers])
+            peaks["server_mb"] = max(peaks["server_mb"], rss_mib(pid))
+            workers = [rss_mib(child) for child in children(pid)]
+            peaks["worker_mb"] = max([peaks["worker_mb"], *(w for w in workers if w == w)])
 
     thread = threading.Thread(target=sample, daemon=True)
     thread.start()

@@ -23,7 +23,7 @@ from app.examples import (
     SIMULATE_EXAMPLE,
 )
 from benchmarks.bench_serving import plan_with
-from benchmarks.common import Server, print_table
+from benchmarks.common import Server, children, print_table, rss_mib
 
 SOAK_S = float(os.environ.get("COLDROUTE_BENCH_SOAK_S", "3600"))
 CLIENTS = 4
@@ -39,29 +39,17 @@ REQUESTS = {
 }
 
 
-def rss_mib(pid: int) -> float:
-    """Resident memory of a process [MiB] (Linux /proc)."""
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1]) / 1024
-    return float("nan")
-
-
 def workers_of(pid: int) -> list[int]:
     """The server's worker processes: its spawned children but the resource tracker (Linux
     /proc)."""
     found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                stat = (entry / "stat").read_text()
-            except OSError:
-                continue
-            if int(stat.rsplit(")", 1)[1].split()[1]) != pid:
-                continue
-            command = (entry / "cmdline").read_bytes()
-            if b"spawn_main" in command and b"resource_tracker" not in command:
-                found.append(int(entry.name))
+    for child in children(pid):
+        try:
+            command = Path(f"/proc/{child}/cmdline").read_bytes()
+        except OSError:
+            continue
+        if b"spawn_main" in command and b"resource_tracker" not in command:
+            found.append(child)
     return sorted(found)
 
 

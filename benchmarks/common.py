@@ -150,6 +150,31 @@ def running_server(env: dict[str, str] | None = None) -> Iterator[str]:
 POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
 
 
+def children(pid: int) -> list[int]:
+    """Direct child processes of ``pid`` (Linux /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                found.append(int(entry.name))
+    return found
+
+
+def rss_mib(pid: int) -> float:
+    """Resident memory of a process [MiB] (Linux /proc); NaN when it is gone."""
+    try:
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return float("nan")
+
+
 @contextmanager
 def celery_cluster(processes: Sequence[int], env: dict[str, str] | None = None) -> Iterator[Server]:
     """A server with Celery workers (one per entry of ``processes``, each with that many worker

@@ -444,12 +444,7 @@ class JobStore:
         with self.transaction() as session:
             session.execute(
                 update(JobPart)
-                .where(
-                    JobPart.job_id == job_id,
-                    JobPart.index.in_(indices),
-                    JobPart.status == "running",
-                    JobPart.runner == runner,
-                )
+                .where(_held(job_id, runner), JobPart.index.in_(indices))
                 .values(heartbeat_at=now())
             )
 
@@ -459,12 +454,7 @@ class JobStore:
         with self.transaction() as session:
             done = session.execute(
                 update(JobPart)
-                .where(
-                    JobPart.job_id == job_id,
-                    JobPart.index == index,
-                    JobPart.status == "running",
-                    JobPart.runner == runner,
-                )
+                .where(_held(job_id, runner), JobPart.index == index)
                 .values(status="done", result=result)  # the runner stays: who did it
             )
             return bool(done.rowcount == 1)  # type: ignore[attr-defined]
@@ -477,14 +467,7 @@ class JobStore:
             values["attempts"] = JobPart.attempts - 1
         with self.transaction() as session:
             session.execute(
-                update(JobPart)
-                .where(
-                    JobPart.job_id == job_id,
-                    JobPart.index == index,
-                    JobPart.status == "running",
-                    JobPart.runner == runner,
-                )
-                .values(values)
+                update(JobPart).where(_held(job_id, runner), JobPart.index == index).values(values)
             )
 
     def requeue_lost_parts(self, job_id: str, stale_after_s: float) -> list[PartView]:
@@ -548,6 +531,11 @@ class JobStore:
                 delete(Job).where(Job.status.in_(FINISHED), Job.finished_at < before)
             )
             return int(gone.rowcount)  # type: ignore[attr-defined]
+
+
+def _held(job_id: str, runner: str) -> ColumnElement[bool]:
+    """The parts of a job that ``runner`` runs now."""
+    return (JobPart.job_id == job_id) & (JobPart.status == "running") & (JobPart.runner == runner)
 
 
 def _part_view(part: JobPart) -> PartView:

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
-from benchmarks.common import vienna_stops
+from benchmarks.common import children, vienna_stops
 
 
 def long_plan(n_stops: int, time_limit_s: float, seed: int = 1) -> dict[str, Any]:
@@ -42,21 +42,6 @@ def big_fleet(n_stops: int, n_vans: int, time_limit_s: float, seed: int = 1) -> 
     ]
     body |= {"objective": "distance", "time_limit_s": time_limit_s, "work_s": 10 * time_limit_s}
     return body
-
-
-def children(pid: int) -> list[int]:
-    """Direct child processes of ``pid`` (Linux /proc)."""
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                stat = (entry / "stat").read_text()
-            except OSError:
-                continue
-            parent = int(stat.rsplit(")", 1)[1].split()[1])
-            if parent == pid:
-                found.append(int(entry.name))
-    return found
 
 
 def cpu_ticks(pids: list[int], window_s: float = 1.0) -> dict[int, int]:
