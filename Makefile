@@ -9,7 +9,7 @@ PBF ?=
 ROUTER_DIR ?= .router/region
 
 .PHONY: test bench serve worker openapi report lint clean router router-serve wheelhouse image \
-	test-image
+	test-image docs
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -35,7 +35,16 @@ $(CHROMIUM):
 	$(SUDO) apt-get install -y --no-install-recommends chromium \
 		|| ($(SUDO) apt-get update && $(SUDO) apt-get install -y --no-install-recommends chromium)
 
-test: lint $(OSRM) $(CHROMIUM)
+# The documentation site (MkDocs), offline, warnings as errors, into app/guide: the service
+# serves it at /guide.
+GUIDE := app/guide/index.html
+$(GUIDE): $(STAMP) mkdocs.yml openapi/openapi.json $(shell find docs -type f)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
+	touch $(GUIDE)
+
+docs: $(GUIDE)
+
+test: lint $(GUIDE) $(OSRM) $(CHROMIUM)
 	$(BIN)/python -m pytest -n 2 --dist worksteal
 
 BENCH_STAMP := $(VENV)/.bench-installed
@@ -54,7 +63,7 @@ router: $(OSRM)
 router-serve: $(OSRM)
 	$(BIN)/python -m tools.osrm serve $(ROUTER_DIR) --port $${OSRM_PORT:-5000}
 
-serve: $(STAMP)
+serve: $(STAMP) $(GUIDE)
 	$(BIN)/python -m app.serve
 
 # A Celery worker for the jobs (needs COLDROUTE_BROKER_URL and a PostgreSQL COLDROUTE_DATABASE_URL).
@@ -74,7 +83,7 @@ report: $(STAMP)
 # with Python 3.11 and its venv module.
 IMAGE ?= coldroute
 BASE ?= python:3.11-slim
-wheelhouse: $(STAMP)
+wheelhouse: $(STAMP) $(GUIDE)
 	rm -rf wheelhouse
 	$(BIN)/python -m pip wheel --quiet . 'async-timeout>=4' -w wheelhouse
 
@@ -95,4 +104,4 @@ test-image: wheelhouse $(DOCKERD) $(DEBOOTSTRAP)
 	rm -rf wheelhouse
 
 clean:
-	rm -rf $(VENV) .router .pytest_cache .mypy_cache .ruff_cache wheelhouse
+	rm -rf $(VENV) .router .pytest_cache .mypy_cache .ruff_cache wheelhouse app/guide

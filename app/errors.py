@@ -27,8 +27,27 @@ E = TypeVar("E", bound=Exception)
 _log = logging.getLogger("coldroute")
 
 
+#: Every kind of problem the service answers, by its title: its status and when it comes.
+#: A problem's ``type`` is ``/problems/<the title in lower case, dashed>``.
+PROBLEMS: dict[str, tuple[int, str]] = {
+    "Invalid request": (422, "a field breaks a rule; `errors[]` names each by its JSON path"),
+    "Limit exceeded": (422, "valid, but beyond what the model allows (a job's work)"),
+    "Request too large": (413, "more stops, vans, samples or bytes than the service takes at once"),
+    "Unauthorized": (401, "`X-API-Key` missing or wrong while `COLDROUTE_API_KEY` is set"),
+    "Not found": (404, "no such path, job or vehicle profile"),
+    "Method not allowed": (405, "the path does not take the method (`Allow` says which do)"),
+    "Conflict": (409, "an `Idempotency-Key` or profile name already used otherwise"),
+    "HTTP error": (400, "a request HTTP itself refuses before it reaches the service"),
+    "Service unavailable": (503, "workers busy, or a database, broker or router down"),
+    "Time limit exceeded": (504, "a job's `error`: it ran longer than its time limit"),
+    "Internal error": (500, "a bug: the answer carries the request id, the log its traceback"),
+}
+
+
 def problem_body(status: int, title: str, detail: str, **extra: Any) -> dict[str, Any]:
-    """An RFC 9457 problem document; ``type`` names the problem kind under /problems/."""
+    """An RFC 9457 problem document of one of :data:`PROBLEMS`."""
+    if title not in PROBLEMS:
+        raise ValueError(f"{title!r} is not a problem the service documents")
     slug = title.lower().replace(" ", "-")
     body = {"type": f"/problems/{slug}", "title": title, "status": status, "detail": detail}
     return body | extra

@@ -33,6 +33,7 @@ from app.operations.kinds import loaded
 from app.routers import (
     calibrations,
     fleet,
+    guide,
     health,
     jobs,
     plans,
@@ -65,7 +66,8 @@ for byte but the timing fields (`solver.runtime_s`): searches stop on their work
 seeded by `seed`), and `time_limit_s` only caps them (`solver.stopped_by` says when it did).
 
 **[The plan viewer](/viewer)** plans a day from a CSV of stops and shows it: the routes on a map,
-the state of charge, the energy per consumer and the box temperature over the day."""
+the state of charge, the energy per consumer and the box temperature over the day.
+**[The guide](/guide/)** explains it all per kind of user, with examples that the tests run."""
 
 
 class BodyLimit:
@@ -394,6 +396,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(v1)
     app.include_router(health.router)
     app.include_router(viewer.router)
+    app.include_router(guide.router)
 
     @app.get("/metrics", include_in_schema=False)
     def prometheus() -> Response:

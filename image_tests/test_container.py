@@ -48,7 +48,12 @@ def test_healthy_answers_plans_as_non_root_and_logs_json_lines(run_container):
             http.get(f"/viewer/static/vendor/{path}")
             for path in ("leaflet/leaflet.js", "leaflet/LICENSE", "uplot/uPlot.iife.min.js")
         ]
+        # the guide, built into the image
+        guide = http.get("/guide/engineers/model/")
+        katex = http.get("/guide/assets/katex/katex.min.js")
     assert viewer.status_code == 200 and "leaflet.js" in viewer.text
+    assert guide.status_code == 200 and "The model" in guide.text
+    assert katex.status_code == 200
     assert [r.status_code for r in libraries] == [200, 200, 200]
     assert plan.status_code == 200, plan.text
     assert len(plan.json()["stops"]) == 8 and plan.json()["battery"]["feasible"]

@@ -25,7 +25,7 @@ from benchmarks.common import Server, busy_core
 from tests.app.apps import app_client
 from tests.app.test_jobs import submit, wait_for
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+GUIDE = Path(__file__).resolve().parents[2] / "docs" / "integrators" / "rounds.md"
 #: The answer's fields that report timing: they differ between runs.
 TIMING = ("runtime_s",)
 
@@ -87,11 +87,11 @@ def test_every_example_answers_the_same_idle_busy_and_as_a_job(server, path, nam
         busy = ask()
     assert first["solver"].get("stopped_by") != "time_limit", first["solver"]
     assert without_timing(first) == without_timing(second) == without_timing(busy)
-    # the figures its description (and the README) quotes are this answer's
+    # the figures its description (and the guide) quotes are this answer's
     recorded = json.loads(RESPONSE_EXAMPLES.read_text())["descriptions"][name]
     assert describe(first) == recorded
     if "charg" in name:
-        assert recorded in " ".join(README.read_text().split())
+        assert recorded in " ".join(GUIDE.read_text().split())
     kind = "plan" if path == "/v1/plans" else "fleet-plan"
     job = wait_for(
         server.url, submit(server.url, {"type": kind, "request": body}).json()["id"], timeout=120
