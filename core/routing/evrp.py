@@ -28,8 +28,9 @@ may not serve (pinned to others).
    the late customers on cost plus :data:`LATE_PENALTY` per unit late until none is (else
    undone) — and the cost: ruin and recreate (a few nearby customers out, each back where it
    costs least, only into routes that hold one of its :data:`NEIGHBOURS` nearest; the
-   customers left out tried again), kept when no worse (a route it empties is a vehicle less
-   too).
+   customers left out tried again; a share of them around a customer beside a charge), kept
+   when no worse (a route it empties is a vehicle less too). Last, each route's stretches
+   turned round where that is shorter (2-opt).
 """
 
 from __future__ import annotations
@@ -88,6 +89,10 @@ ELIMINATION_BUDGET = 0.2
 #: every route has had its turn.
 DISTANCE_MOVES = 100
 START_THRESHOLD = 0.02
+#: Share of the ruin-and-recreate moves on the cost that start beside a charge (a customer
+#: just before or after a station): where a route's charges could go, or one could go away,
+#: if its customers were shared out otherwise.
+BESIDE_CHARGE_SHARE = 0.25
 ELIMINATION_EVERY = 10
 
 
@@ -236,6 +241,8 @@ def solve_evrptw(
         searches[-1].start(routes)
     search = min(searches, key=lambda s: s.total())
     ended = search.improve(effort.work_s * (1.0 - ROUTING_SHARE), effort)
+    search.restore_best()
+    search.polish(effort)
     return search.solution(ended)
 
 
@@ -645,6 +652,10 @@ class _Search(_Solution):
             if late:
                 pick = late[int(self.rng.integers(len(late)))]
                 seed = customers.index(pick[int(self.rng.integers(len(pick)))])
+        elif self.rng.random() < BESIDE_CHARGE_SHARE:
+            beside = self._beside_charges()
+            if beside:
+                seed = customers.index(beside[int(self.rng.integers(len(beside)))])
         size = int(self.rng.integers(2, RUIN_SIZE + 1))
         taken = {customers[k] for k in self.nearest[seed][:size]} - set(self.left)
         self.routes = [(k, [c for c in r if c not in taken]) for k, r in self.routes]
@@ -662,10 +673,44 @@ class _Search(_Solution):
         if not placed or worse or not self.holds():
             self.routes, self.left = saved
 
-    def solution(self, ended: SearchEnd) -> EvrpSolution:
+    def restore_best(self) -> None:
+        """The best routes seen, on the routes' own cost (no lateness)."""
         self.priced.penalty = math.inf
         if self.best is not None and self.best[0] < self.total():
             _, self.routes, self.left = self.best
+
+    def polish(self, effort: Effort) -> None:
+        """Each route's stretches of customers turned round (2-opt), the first that makes it
+        cheaper kept while the routes still hold together, until none does: ruin and
+        recreate moves customers one by one and never drives a stretch the other way."""
+        for r in range(len(self.routes)):
+            while not effort.out_of_time() and self._turned_round(r):
+                self.moves += 1
+
+    def _turned_round(self, r: int) -> bool:
+        kind, route = self.routes[r]
+        now = self.cost(kind, route)
+        for i in range(len(route) - 1):
+            for j in range(i + 2, len(route) + 1):
+                turned = [*route[:i], *route[i:j][::-1], *route[j:]]
+                if self.cost(kind, turned) < now - 1e-9:
+                    self.routes[r] = (kind, turned)
+                    if self.holds():
+                        return True
+                    self.routes[r] = (kind, route)
+        return False
+
+    def _beside_charges(self) -> list[int]:
+        """The customers just before and after each station the routes charge at."""
+        beside: list[int] = []
+        for charged in self.booked():
+            for p in np.flatnonzero(charged.gaps >= 0):
+                ends = (int(charged.seq[p]), int(charged.seq[p + 1]))
+                beside += [c for c in ends if c in self.is_customer]
+        return beside
+
+    def solution(self, ended: SearchEnd) -> EvrpSolution:
+        self.restore_best()
         booked = self.booked()
         routes = [EvrpRoute(k, c.visits) for (k, _), c in zip(self.routes, booked, strict=True)]
         distance = sum(c.distance for c in booked)

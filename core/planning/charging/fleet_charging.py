@@ -330,22 +330,26 @@ def measure(
 def battery_margin(
     day: FleetDay, routes: list[list[int]], results: Mapping[int, PlanResult]
 ) -> float:
-    """The share of the batteries the charging search plans with: the least, over the
-    simulated routes found without charging (one trip, no charge), of the energy the estimates
-    gave the route over what the simulation drew from the battery — at most 1, at least
-    :data:`MIN_BATTERY_MARGIN`; :data:`BATTERY_MARGIN` when no route says."""
-    shares = []
+    """The share of the batteries the charging search plans with: over the simulated routes
+    found without charging (one trip, no charge), the energy the estimates gave them over what
+    the simulation drew from the battery, together — at most 1, at least
+    :data:`MIN_BATTERY_MARGIN`; :data:`BATTERY_MARGIN` when no route says. Together, not the
+    worst route's: a route the simulation finds short makes its kind's battery smaller by its
+    shortfall (:func:`charging_routes`), and each percent held back for the worst is range
+    lost on every route (on the Vienna day of the benchmark the worst route's 0.914 against
+    0.942 together cost a third charge and 8 km)."""
+    estimated_kwh = drawn_kwh = 0.0
     for v, result in results.items():
         if not routes[v] or result.charges or 0 in routes[v]:
             continue
         battery = result.battery
-        drawn_kwh = (result.legs[0].soc_start - battery.final_soc) * battery.usable_capacity_kwh
-        if drawn_kwh > 0:
-            estimated_kwh = day.estimates[v].route_energy_j(routes[v]) / JOULES_PER_KWH
-            shares.append(estimated_kwh / drawn_kwh)
-    if not shares:
+        drawn = (result.legs[0].soc_start - battery.final_soc) * battery.usable_capacity_kwh
+        if drawn > 0:
+            estimated_kwh += day.estimates[v].route_energy_j(routes[v]) / JOULES_PER_KWH
+            drawn_kwh += drawn
+    if not drawn_kwh:
         return BATTERY_MARGIN
-    return min(max(min(shares), MIN_BATTERY_MARGIN), 1.0)
+    return min(max(estimated_kwh / drawn_kwh, MIN_BATTERY_MARGIN), 1.0)
 
 
 def charging_routes(
