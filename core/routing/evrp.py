@@ -12,8 +12,8 @@ may not serve (pinned to others).
 
 1. **Routes of customers**: given (a planner's routes without charging), or PyVRP's routes of
    the customers alone, with windows and load, its arc times lengthened by
-   :data:`CHARGE_TIME_SHARE` of the time the arc's energy takes to charge (charging is time a
-   route must find room for).
+   :data:`CHARGE_TIME_SHARES` of the time the arc's energy takes to charge (charging is time a
+   route must find room for), and without it.
 2. **Stations on a route** (:mod:`core.routing.stations`): for a fixed order of customers, the
    stations between them and how much to charge at each, by labels; a station takes no
    charge while it is closed. **Shared points**: at a station with fewer points than the
@@ -28,9 +28,9 @@ may not serve (pinned to others).
    the late customers on cost plus :data:`LATE_PENALTY` per unit late until none is (else
    undone) — and the cost: ruin and recreate (a few nearby customers out, each back where it
    costs least, only into routes that hold one of its :data:`NEIGHBOURS` nearest; the
-   customers left out tried again; a share of them around a customer beside a charge), kept
-   when no worse (a route it empties is a vehicle less too). Last, each route's stretches
-   turned round where that is shorter (2-opt).
+   customers left out tried again), kept
+   when no worse (a route it empties is a vehicle less too). Last, the routes polished: a
+   stretch turned round (2-opt), two routes' ends exchanged (2-opt*), while that is cheaper.
 """
 
 from __future__ import annotations
@@ -55,8 +55,10 @@ from core.routing.stations import (
     station_candidates,
 )
 
-#: Share of the charging time of an arc's energy that step 1 adds to the arc's time.
-CHARGE_TIME_SHARE = 0.5
+#: Shares of the charging time of an arc's energy that step 1 adds to the arc's time: routes
+#: found with part of it leave room for charging where windows are tight; routes found without
+#: it are the shortest where the day has room to charge anyway (each a start of its own).
+CHARGE_TIME_SHARES = (0.5, 0.0)
 #: Share of the work for step 1.
 ROUTING_SHARE = 0.15
 #: The search's work [reference s]: this much per route evaluated (with its stations) and per
@@ -89,10 +91,8 @@ ELIMINATION_BUDGET = 0.2
 #: every route has had its turn.
 DISTANCE_MOVES = 100
 START_THRESHOLD = 0.02
-#: Share of the ruin-and-recreate moves on the cost that start beside a charge (a customer
-#: just before or after a station): where a route's charges could go, or one could go away,
-#: if its customers were shared out otherwise.
-BESIDE_CHARGE_SHARE = 0.25
+#: Share of the search's work for the last step, the routes' polish (2-opt and 2-opt*).
+POLISH_SHARE = 0.05
 ELIMINATION_EVERY = 10
 
 
@@ -232,7 +232,8 @@ def solve_evrptw(
     part of the charging time, routes found without may not)."""
     starts = [] if initial is None else [initial]
     if all(kind.start == 0 for kind in instance.kinds):
-        starts.append(_customer_routes(instance, effort.share(ROUTING_SHARE)))
+        share = ROUTING_SHARE / len(CHARGE_TIME_SHARES)
+        starts += [_customer_routes(instance, effort.share(share), c) for c in CHARGE_TIME_SHARES]
     if not starts:
         raise ValueError("routes of customers for vehicles under way must be given")
     searches = []
@@ -240,21 +241,22 @@ def solve_evrptw(
         searches.append(_Search(instance, np.random.default_rng(effort.seed)))
         searches[-1].start(routes)
     search = min(searches, key=lambda s: s.total())
-    ended = search.improve(effort.work_s * (1.0 - ROUTING_SHARE), effort)
+    ended = search.improve(effort.work_s * (1.0 - ROUTING_SHARE - POLISH_SHARE), effort)
     search.restore_best()
-    search.polish(effort)
+    if ended == "work":
+        ended = search.polish(effort.work_s * POLISH_SHARE, effort)
     return search.solution(ended)
 
 
-def _customer_routes(instance: EvrpInstance, effort: Effort) -> Routes:
-    """Step 1: PyVRP's routes of the customers, charging time partly in the arcs (the first
-    kind's energy), every kind a vehicle type of its own."""
+def _customer_routes(instance: EvrpInstance, effort: Effort, charge_share: float) -> Routes:
+    """Step 1: PyVRP's routes of the customers, ``charge_share`` of the charging time in the
+    arcs (the first kind's energy), every kind a vehicle type of its own."""
     customers = instance.customers
     nodes = [0, *customers]
     arcs = np.ix_(nodes, nodes)
     distance = np.rint(instance.distance[arcs] * _SCALE).astype(np.int64)
     stations = instance.stations or [0]
-    charge = float(np.mean(instance.charge_time[stations])) * CHARGE_TIME_SHARE
+    charge = float(np.mean(instance.charge_time[stations])) * charge_share
     arc_time = instance.duration[arcs] + charge * instance.kinds[0].energy[arcs]
     duration = np.rint(arc_time * _SCALE).astype(np.int64)
     for matrix in (distance, duration):  # staying put: an energy per arc may count a stop's
@@ -652,10 +654,6 @@ class _Search(_Solution):
             if late:
                 pick = late[int(self.rng.integers(len(late)))]
                 seed = customers.index(pick[int(self.rng.integers(len(pick)))])
-        elif self.rng.random() < BESIDE_CHARGE_SHARE:
-            beside = self._beside_charges()
-            if beside:
-                seed = customers.index(beside[int(self.rng.integers(len(beside)))])
         size = int(self.rng.integers(2, RUIN_SIZE + 1))
         taken = {customers[k] for k in self.nearest[seed][:size]} - set(self.left)
         self.routes = [(k, [c for c in r if c not in taken]) for k, r in self.routes]
@@ -679,35 +677,61 @@ class _Search(_Solution):
         if self.best is not None and self.best[0] < self.total():
             _, self.routes, self.left = self.best
 
-    def polish(self, effort: Effort) -> None:
-        """Each route's stretches of customers turned round (2-opt), the first that makes it
-        cheaper kept while the routes still hold together, until none does: ruin and
-        recreate moves customers one by one and never drives a stretch the other way."""
-        for r in range(len(self.routes)):
-            while not effort.out_of_time() and self._turned_round(r):
-                self.moves += 1
+    def polish(self, work_s: float, effort: Effort) -> SearchEnd:
+        """The last step, for at most ``work_s`` [reference s]: the first change that makes the
+        routes cheaper and keeps them holding together, until none does — a route's stretch of
+        customers turned round (2-opt), or two routes' ends exchanged (2-opt*: what ruin and
+        recreate, moving customers one by one, does not do: a van's last stretch, charges
+        and all, handed to another)."""
+        end = self.spent_s + work_s
+        while self.spent_s < end:
+            if effort.out_of_time():
+                return "time_limit"
+            turned = any(self._turned_round(r) for r in range(len(self.routes)))
+            if not turned and not self._ends_exchanged():
+                return "work"
+            self.moves += 1
+        return "work"
 
     def _turned_round(self, r: int) -> bool:
         kind, route = self.routes[r]
         now = self.cost(kind, route)
         for i in range(len(route) - 1):
             for j in range(i + 2, len(route) + 1):
-                turned = [*route[:i], *route[i:j][::-1], *route[j:]]
-                if self.cost(kind, turned) < now - 1e-9:
-                    self.routes[r] = (kind, turned)
-                    if self.holds():
-                        return True
-                    self.routes[r] = (kind, route)
+                if self._kept([(r, [*route[:i], *route[i:j][::-1], *route[j:]])], now):
+                    return True
         return False
 
-    def _beside_charges(self) -> list[int]:
-        """The customers just before and after each station the routes charge at."""
-        beside: list[int] = []
-        for charged in self.booked():
-            for p in np.flatnonzero(charged.gaps >= 0):
-                ends = (int(charged.seq[p]), int(charged.seq[p + 1]))
-                beside += [c for c in ends if c in self.is_customer]
-        return beside
+    def _ends_exchanged(self) -> bool:
+        for a in range(len(self.routes)):
+            for b in range(a + 1, len(self.routes)):
+                (ka, ra), (kb, rb) = self.routes[a], self.routes[b]
+                now = self.cost(ka, ra) + self.cost(kb, rb)
+                for i in range(len(ra) + 1):
+                    for j in range(len(rb) + 1):
+                        if (i, j) in ((0, 0), (len(ra), len(rb))):
+                            continue  # the same routes
+                        if self._kept([(a, [*ra[:i], *rb[j:]]), (b, [*rb[:j], *ra[i:]])], now):
+                            return True
+        return False
+
+    def _kept(self, changed: list[tuple[int, list[int]]], now: float) -> bool:
+        """The routes ``changed`` (index, new customers) kept when they cost less than ``now``
+        together and every route still holds; a route left without customers is a vehicle
+        less."""
+        cost = sum(
+            self.cost(self.routes[r][0], route) for r, route in changed if self._customers(route)
+        )
+        if cost >= now - 1e-9:
+            return False
+        saved = self._saved()
+        for r, route in changed:
+            self.routes[r] = (self.routes[r][0], route)
+        self.routes = [(k, r) for k, r in self.routes if self._customers(r)]
+        if self.holds():
+            return True
+        self.routes, self.left = saved
+        return False
 
     def solution(self, ended: SearchEnd) -> EvrpSolution:
         self.restore_best()

@@ -81,6 +81,23 @@ MIN_BATTERY_MARGIN = 0.85
 CHARGING_ROUNDS = 3
 FIRST_SHARE = 0.7
 TIGHTEN_MARGIN = 1.2
+#: And at least this share of the battery: a route that ends a rounding below its reserve
+#: would otherwise send the search back to the same routes. Likewise a route back after its
+#: shift makes its kind's latest return earlier, by at least this [s].
+MIN_TIGHTEN_SHARE = 0.01
+MIN_TIGHTEN_S = 300.0
+
+
+@dataclass(frozen=True)
+class Short:
+    """By kind of van, the most a simulated route fell below its reserve [J] and came back
+    after its shift [s]: what the search's estimates missed."""
+
+    energy_j: dict[int, float] = field(default_factory=dict)
+    late_s: dict[int, float] = field(default_factory=dict)
+
+    def __bool__(self) -> bool:
+        return bool(self.energy_j or self.late_s)
 
 
 @dataclass
@@ -363,7 +380,8 @@ def charging_routes(
     search's own (every van at the depot) and ``routes`` (stops per van, a 0 a return to
     reload) found without. A route whose simulation runs below its reserve
     makes its kind of van's battery (and its charge at departure) smaller in the search by what
-    the simulation fell below the reserve, :data:`TIGHTEN_MARGIN` times, and the search starts
+    the simulation fell below the reserve, one back after its shift the kind's latest return
+    earlier by its lateness (:func:`_tightened`), and the search starts
     again from ``routes`` (which hold without charging; the routes it found may not hold with
     the smaller battery even when charged), at most
     :data:`CHARGING_ROUNDS` times; the best verified routes are kept."""
@@ -407,35 +425,38 @@ def _ranked(day: FleetDay, charging: Charging, fewest_vans: bool) -> tuple[int, 
     return measure(day, charging.routes, charging.results, fewest_vans)
 
 
-def _tightened(instance: EvrpInstance, short_j: dict[int, float]) -> EvrpInstance:
+def _tightened(instance: EvrpInstance, short: Short) -> EvrpInstance:
     """Each kind's battery and charge at departure less what its simulated routes fell below
-    the reserve [J], :data:`TIGHTEN_MARGIN` times."""
-    kinds = [
-        replace(
-            kind,
-            battery=kind.battery - short_j[k] * TIGHTEN_MARGIN,
-            initial=kind.initial - short_j[k] * TIGHTEN_MARGIN,
-        )
-        if k in short_j
-        else kind
-        for k, kind in enumerate(instance.kinds)
-    ]
-    return replace(instance, kinds=kinds)
+    the reserve, and its latest return earlier by how late they came back, each
+    :data:`TIGHTEN_MARGIN` times, at least :data:`MIN_TIGHTEN_SHARE` of the battery and
+    :data:`MIN_TIGHTEN_S`."""
+
+    def less(k: int, kind: VehicleKind) -> VehicleKind:
+        if k in short.energy_j:
+            cut = max(short.energy_j[k] * TIGHTEN_MARGIN, kind.battery * MIN_TIGHTEN_SHARE)
+            kind = replace(kind, battery=kind.battery - cut, initial=kind.initial - cut)
+        if k in short.late_s:
+            kind = replace(
+                kind, due=kind.due - max(short.late_s[k] * TIGHTEN_MARGIN, MIN_TIGHTEN_S)
+            )
+        return kind
+
+    return replace(instance, kinds=[less(k, kind) for k, kind in enumerate(instance.kinds)])
 
 
 def _verified(
     day: FleetDay, charging: ChargingInstance, solution: EvrpSolution
-) -> tuple[Charging, dict[int, float]]:
+) -> tuple[Charging, Short]:
     """Each route of ``solution`` given to a van of its kind, simulated with its charges
-    fitted and the charge points booked, repaired until it holds; and by kind, the most a
-    route fell below its reserve for its battery [J]."""
+    fitted and the charge points booked, repaired until it holds; and by kind, what the
+    routes' first simulations fell short by."""
     places = day.scene.places
     bookings = Bookings(charging.points)
     index = {place.id: k for k, place in enumerate(places)}
     routes: list[list[int]] = [[] for _ in day.vans]
     results: dict[int, PlanResult] = {}
     removed: dict[int, Failure] = {}
-    short: dict[int, float] = {}
+    short = Short()
     free = [list(vans) for vans in charging.vans_of]
     for route in solution.routes:
         v = free[route.kind].pop(0)
@@ -450,7 +471,11 @@ def _verified(
         repaired, first = _held(day, v, itinerary, bookings)
         if first is not None and first.battery.margin_kwh < 0:
             below_j = -first.battery.margin_kwh * JOULES_PER_KWH
-            short[route.kind] = max(short.get(route.kind, 0.0), below_j)
+            short.energy_j[route.kind] = max(short.energy_j.get(route.kind, 0.0), below_j)
+        end = day.shifts[v].end
+        if first is not None and end is not None and first.legs[-1].arrive > end:
+            late_s = (first.legs[-1].arrive - end).total_seconds()
+            short.late_s[route.kind] = max(short.late_s.get(route.kind, 0.0), late_s)
         routes[v] = repaired.route
         removed |= repaired.removed
         if repaired.result is not None:

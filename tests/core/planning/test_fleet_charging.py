@@ -17,7 +17,12 @@ from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop, TimeWi
 from core.planning.charging.fleet_charging import (
     BATTERY_MARGIN,
     MIN_BATTERY_MARGIN,
+    MIN_TIGHTEN_S,
+    MIN_TIGHTEN_SHARE,
+    TIGHTEN_MARGIN,
     Bookings,
+    Short,
+    _tightened,
     battery_margin,
     charging_instance,
 )
@@ -239,6 +244,32 @@ def test_the_search_plans_with_the_share_of_the_battery_the_estimates_earned():
     assert battery_margin(day, [[], []], {}) == BATTERY_MARGIN
     # a route that reloads says nothing of one trip's estimate
     assert battery_margin(day, [[1, 0, 2], []], {0: results[0]}) == BATTERY_MARGIN
+
+
+def test_a_route_short_of_energy_or_late_tightens_its_kind_for_the_next_search():
+    """What the simulation says a route fell short by goes back to the search, with margin:
+    1.2 × a shortfall of 2 kWh off the battery and the charge at departure; a rounding below
+    the reserve (1 J) or a minute late still moves the search (1 % of the battery, 5 min)."""
+    stops, matrix = clusters()
+    problem = cluster_fleet(stops, [cluster_van("a"), cluster_van("b")], matrix=matrix)
+    problem = problem.model_copy(
+        update={"depot": DEPOT.model_copy(update={"charger": ChargePoint(power_kw=22)})}
+    )
+    day = cluster_day(problem)
+    instance = charging_instance(day, day.duration_s, True).instance
+    (kind,) = instance.kinds  # two vans alike: one kind
+    two_kwh = 2 * 3.6e6
+    less = _tightened(instance, Short(energy_j={0: two_kwh})).kinds[0]
+    assert kind.battery - less.battery == pytest.approx(TIGHTEN_MARGIN * two_kwh)
+    assert kind.initial - less.initial == pytest.approx(TIGHTEN_MARGIN * two_kwh)
+    assert less.due == kind.due
+    rounding = _tightened(instance, Short(energy_j={0: 1.0}, late_s={0: 60.0})).kinds[0]
+    assert kind.battery - rounding.battery == pytest.approx(MIN_TIGHTEN_SHARE * kind.battery)
+    assert kind.due - rounding.due == pytest.approx(MIN_TIGHTEN_S)
+    late = _tightened(instance, Short(late_s={0: 1200.0})).kinds[0]
+    assert kind.due - late.due == pytest.approx(TIGHTEN_MARGIN * 1200.0)
+    assert late.battery == kind.battery
+    assert not Short() and Short(late_s={0: 1.0})
 
 
 def test_the_search_knows_each_chargers_points_and_opening_hours():
