@@ -12,6 +12,8 @@ from fastapi import APIRouter, Response
 from fastapi.responses import RedirectResponse
 from starlette.exceptions import HTTPException
 
+from app.routers.viewer import files_under
+
 router = APIRouter(include_in_schema=False)
 
 #: What the guide's pages may load: their own files. Material's two small inline scripts and
@@ -25,22 +27,11 @@ POLICY = (
 MEDIA_TYPES = {".js": "text/javascript", ".woff2": "font/woff2", ".xml": "application/xml"}
 
 
-def _walk(folder: Traversable, prefix: str = "") -> dict[str, Traversable]:
-    found: dict[str, Traversable] = {}
-    for entry in folder.iterdir():
-        name = f"{prefix}{entry.name}"
-        if entry.is_dir():
-            found |= _walk(entry, f"{name}/")
-        else:
-            found[name] = entry
-    return found
-
-
 @cache
 def _site() -> dict[str, Traversable]:
     """Every file of the built site by its path under /guide/ (empty when it was not built)."""
     site = files("app").joinpath("guide")
-    return _walk(site) if site.is_dir() else {}
+    return files_under(site, lambda _: True) if site.is_dir() else {}
 
 
 def _media_type(name: str) -> str:

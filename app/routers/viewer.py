@@ -6,6 +6,7 @@ tiles."""
 from __future__ import annotations
 
 import html
+from collections.abc import Callable
 from functools import cache
 from importlib.resources import files
 from importlib.resources.abc import Traversable
@@ -27,22 +28,31 @@ POLICY = (
 MEDIA_TYPES = {".js": "text/javascript", ".css": "text/css", ".png": "image/png"}
 
 
-def _walk(folder: Traversable, prefix: str = "") -> dict[str, Traversable]:
+def files_under(
+    folder: Traversable, served: Callable[[str], bool], prefix: str = ""
+) -> dict[str, Traversable]:
+    """Every file under ``folder`` whose path ``served`` accepts, by its path under it."""
     found: dict[str, Traversable] = {}
     for entry in folder.iterdir():
         name = f"{prefix}{entry.name}"
         if entry.is_dir():
-            found |= _walk(entry, f"{name}/")
-        elif any(name.endswith(suffix) for suffix in MEDIA_TYPES) or entry.name == "LICENSE":
+            found |= files_under(entry, served, f"{name}/")
+        elif served(name):
             found[name] = entry
     return found
+
+
+def _served(name: str) -> bool:
+    """The viewer's own files and its libraries with their licences."""
+    licence = name.rsplit("/", 1)[-1] == "LICENSE"
+    return licence or any(name.endswith(suffix) for suffix in MEDIA_TYPES)
 
 
 @cache
 def _assets() -> dict[str, Traversable]:
     """Every file the viewer may serve by its path under /viewer/static/ — the page's own
     script and style and the vendored libraries with their licences; nothing else."""
-    return _walk(files("app.viewer"))
+    return files_under(files("app.viewer"), _served)
 
 
 @cache
