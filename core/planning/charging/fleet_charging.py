@@ -15,10 +15,11 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    to 80 %), its plug-in time, its points when fewer than the vans (the search shares them
    out) and when it is closed (outside its opening hours); each stop's window (the first
    opening to the last close).
-2. **The search** starts from the better of its own routes of the stops, found with part of
-   the charging time in the arcs (when every van leaves the depot), and the routes the fleet's
-   search found without charging (the stops left out inserted where they cost least), and
-   serves every stop it can, then fewest vans (when asked), then the objective.
+2. **The search** starts from the two best of its own routes of the stops, found with and
+   without part of the charging time in the arcs (when every van leaves the depot), and the
+   routes the fleet's search found without charging (the stops left out inserted where they
+   cost least), each with half the work, keeps the better, and serves every stop it can,
+   then fewest vans (when asked), then the objective.
 3. **Verification**: each route is simulated with its charges fitted to what the simulation
    says each stretch takes (:func:`core.planning.day.recharge.with_charges`), the charge points
    free only between the other vans' charges as simulated (:class:`Bookings`: the search
@@ -376,7 +377,7 @@ def charging_routes(
     minimize_vehicles: bool,
     effort: Effort,
 ) -> Charging:
-    """The fleet's routes with charging (module docstring), from the better start of the
+    """The fleet's routes with charging (module docstring), from the best starts of the
     search's own (every van at the depot) and ``routes`` (stops per van, a 0 a return to
     reload) found without. A route whose simulation runs below its reserve
     makes its kind of van's battery (and its charge at departure) smaller in the search by what
