@@ -247,9 +247,9 @@ def solve_evrptw(
         searches.append(_Search(instance, np.random.default_rng(effort.seed)))
         searches[-1].start(routes)
     searched = sorted(searches, key=lambda s: s.total())[:SEARCHED_STARTS]
+    work_s = effort.work_s * (1.0 - ROUTING_SHARE - POLISH_SHARE) / len(searched)
     ended: SearchEnd = "work"
     for search in searched:
-        work_s = effort.work_s * (1.0 - ROUTING_SHARE - POLISH_SHARE) / len(searched)
         ended = search.improve(work_s, effort)
         search.restore_best()
         if ended == "time_limit":
