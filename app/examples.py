@@ -392,8 +392,17 @@ def record() -> dict[str, Any]:
     # The calibration's record goes to a database of its own, not to the checkout's.
     database = tempfile.mkdtemp(prefix="coldroute-examples-")
     settings = Settings(database_url=f"sqlite:///{database}/examples.db")
-    planned = plan.plan_response(plan.run_plan(PlanRequest.model_validate(PLAN_EXAMPLE), settings))
-    plan_json = planned.model_dump(mode="json")
+    planned = {
+        name: plan.plan_response(plan.run_plan(PlanRequest.model_validate(body), settings))
+        for name, (_, body) in PLAN_EXAMPLES.items()
+    }
+    answers = {name: answer.model_dump(mode="json") for name, answer in planned.items()} | {
+        name: fleet_plan.fleet_response(
+            fleet_plan.run_fleet_plan(FleetPlanRequest.model_validate(body), settings)
+        ).model_dump(mode="json")
+        for name, (_, body) in FLEET_EXAMPLES.items()
+    }
+    plan_json = answers["vienna-8-stops"]
     accepted = dt.datetime(2026, 7, 14, 22, 0, 3, tzinfo=dt.UTC)
     job = JobOut(
         id="6f1c2a9e-4b7d-4e0a-9a51-2f7f3c1d8e20",
@@ -403,29 +412,15 @@ def record() -> dict[str, Any]:
         started_at=accepted + dt.timedelta(seconds=0.4),
         finished_at=accepted + dt.timedelta(seconds=0.5),
         attempts=1,
-        result=planned,
+        result=planned["vienna-8-stops"],
     )
-    descriptions = {
-        name: describe(
-            plan.plan_response(
-                plan.run_plan(PlanRequest.model_validate(body), settings)
-            ).model_dump(mode="json")
-        )
-        for name, (_, body) in PLAN_EXAMPLES.items()
-    } | {
-        name: describe(
-            fleet_plan.fleet_response(
-                fleet_plan.run_fleet_plan(FleetPlanRequest.model_validate(body), settings)
-            ).model_dump(mode="json")
-        )
-        for name, (_, body) in FLEET_EXAMPLES.items()
-    }
     return {
-        "descriptions": descriptions,
+        "descriptions": {name: describe(answer) for name, answer in answers.items()},
+        # each example's work, sent with it (openapi_doc.request_examples): its figures are
+        # these whatever the machine and its load
+        "replays": {name: answer["solver"]["replay"] for name, answer in answers.items()},
         "plan": plan_json,
-        "fleet_plan": fleet_plan.fleet_response(
-            fleet_plan.run_fleet_plan(FleetPlanRequest.model_validate(FLEET_PLAN_EXAMPLE), settings)
-        ).model_dump(mode="json"),
+        "fleet_plan": answers["vienna-two-vans"],
         "simulate": simulate.simulate_trace(
             SimulateRequest.model_validate(SIMULATE_EXAMPLE), settings
         ).model_dump(mode="json"),

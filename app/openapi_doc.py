@@ -67,11 +67,17 @@ EXAMPLES = {
 
 def request_examples(examples: dict[str, tuple[str, dict[str, Any]]]) -> dict[str, Any]:
     """Swagger's request examples: each with its summary and, as its description, the figures
-    of its answer as ``make openapi`` recorded them (``app.examples.describe``)."""
+    of its answer as ``make openapi`` recorded them (``app.examples.describe``); a search's
+    example pinned to the work it did then (its ``replay``), so that its figures are these on
+    any machine."""
     recorded = json.loads(RESPONSE_EXAMPLES.read_text()) if RESPONSE_EXAMPLES.exists() else {}
     described = recorded.get("descriptions", {})
+    replays = recorded.get("replays", {})
     return {
-        name: {"summary": summary, "value": body}
+        name: {
+            "summary": summary,
+            "value": body | ({"replay": replays[name]} if name in replays else {}),
+        }
         | ({"description": f"Answers: {described[name]}"} if name in described else {})
         for name, (summary, body) in examples.items()
     }

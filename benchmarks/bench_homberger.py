@@ -81,8 +81,13 @@ def homberger(name: str) -> Instance:
     windows = _section(lines, "TIME_WINDOW_SECTION")
     horizon = windows[0][1]
     scale = DAY_END_MIN / horizon
+    # rounded inwards, but at least a minute wide (type 2 has windows narrower than a minute)
     window_min = [
-        (math.ceil(a * scale), min(math.floor(b * scale), DAY_END_MIN)) for a, b in windows
+        (
+            math.ceil(a * scale),
+            max(min(math.floor(b * scale), DAY_END_MIN), math.ceil(a * scale) + 1),
+        )
+        for a, b in windows
     ]
     solution = (folder / f"{name}.sol").read_text().splitlines()
     routes = sum(1 for line in solution if line.startswith("Route"))

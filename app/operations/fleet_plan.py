@@ -92,6 +92,7 @@ def fleet_response(
             objective_value=result.objective_value,
             runtime_s=result.runtime_s,
             stopped_by=result.stopped_by,
+            replay=result.replay,
             verification_rounds=result.verification_rounds,
         ),
         timezone=result.timezone,

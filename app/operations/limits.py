@@ -8,7 +8,7 @@ import numpy as np
 
 from app.settings import Settings
 from core.exceptions import ServerLimitError
-from core.planning.model import WORK_SHARE, FleetFields, PlanFields, RoundFields
+from core.planning.model import FleetFields, PlanFields, RoundFields
 from core.routing.geo import great_circle_m
 
 
@@ -34,10 +34,15 @@ def check_fleet_size(request: FleetFields, vehicles: int, settings: Settings) ->
 def search_limits(request: PlanFields | FleetFields, settings: Settings) -> dict[str, Any]:
     """A request's search within the server's cap: its time limit capped [s], its work from
     the limit the request asked for — so the same request does the same search whatever the
-    server's cap, and a cap that stops it says so."""
+    server's cap, and a cap that stops it says so; a request that asks for no limit gets the
+    default for its size within the cap, and the work of that."""
     requested_s = request.time_limit_s
-    work_s = request.work_s if request.work_s is not None else WORK_SHARE * requested_s
-    return {"time_limit_s": min(requested_s, settings.max_time_limit_s), "work_s": work_s}
+    if "time_limit_s" not in request.model_fields_set:  # the default fits within the cap
+        requested_s = min(requested_s, settings.max_time_limit_s)
+    return {
+        "time_limit_s": min(requested_s, settings.max_time_limit_s),
+        "work_s": request.work(requested_s),
+    }
 
 
 def far_stops(request: RoundFields, settings: Settings) -> list[str]:

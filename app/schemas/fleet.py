@@ -10,6 +10,7 @@ from core.params import Objective
 from core.planning.model import (
     FleetFields,
     FleetStatus,
+    Replay,
     ShiftFields,
     Unassigned,
     vehicles_field,
@@ -68,6 +69,11 @@ class FleetSolverOut(ApiModel):
     objective: Objective = Field(..., description="What the routes minimised.")
     objective_value: float = Field(
         ..., description="Of every route together, in m, s or Wh (estimate)."
+    )
+    replay: Replay | None = Field(
+        None,
+        description="The work the searches did: sent back as the request's replay, the same "
+        "answer to the byte but for the runtime_s fields.",
     )
     runtime_s: float = Field(
         ...,

@@ -7,13 +7,14 @@ what comes back — a simulated round (:class:`PlanResult`) and a fleet's day
 from __future__ import annotations
 
 import datetime as dt
+import hashlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, Discriminator, Field, Tag, ValidationInfo, field_validator
 
-from core.exceptions import InvalidStopsError
+from core.exceptions import InvalidParameterError, InvalidStopsError
 from core.params import (
     BRANCH_TAG,
     MAX_CHARGERS,
@@ -51,32 +52,74 @@ DEPOT_CHARGER_ID = "depot"
 MAX_ROUND_S = 7 * 86_400.0
 #: Most vans in one fleet plan (the server's setting may allow fewer).
 MAX_VEHICLES = 1000
-#: Longest a round's search may run [s] when the request gives no limit; its work (a tenth, a
-#: reference second) proves rounds of up to about 60 stops optimal and brings larger ones
-#: within about 0.1 % of LKH-3.
-PLAN_TIME_LIMIT_S = 10.0
-#: Longest a fleet's search may run [s] when the request gives none: the split across vans and
-#: the verification by simulation take longer than one round.
-FLEET_TIME_LIMIT_S = 50.0
 #: Longest a problem may ask its search to run, and most work it may ask for [s].
 MAX_TIME_LIMIT_S = 600.0
 #: Least search time [s]: less is no search at all (and 1e-300 s is not a time).
 MIN_TIME_LIMIT_S = 0.01
-#: The search's work when the request gives none: this share of ``time_limit_s`` — on the
-#: reference machine it is done, with the simulations and the charging search around it,
-#: within a third of the limit, and within the limit with both cores busy with other solves.
-WORK_SHARE = 0.1
+#: The search's work when the request gives none: this share of ``time_limit_s``, in
+#: reference seconds (:mod:`core.routing.effort`). The rest of the limit is for what is not
+#: counted as work — the simulations that verify the routes, the answer — and for a machine
+#: a little busier than the reference: on the reference machine, idle, a default fleet of 25
+#: to 1,000 stops uses 60–90 % of its limit (``benchmarks/bench_limits.py``).
+WORK_SHARE = 0.85
+#: What a search's answer takes besides its work, whatever its size [s]: the matrix, the
+#: estimates, the weather, the first simulations (0.2–0.3 s on the reference machine): the
+#: work is :data:`WORK_SHARE` of the limit less this, and at least :data:`LEAST_WORK_SHARE`
+#: of the limit.
+SETUP_S = 0.3
+LEAST_WORK_SHARE = 0.1
 
 
-def time_limit_field(default_s: float) -> float:
-    """The ``time_limit_s`` field of a problem with its default [s]."""
+def default_work_s(time_limit_s: float) -> float:
+    """The work of a search given ``time_limit_s`` and no work [reference s]: what the
+    reference machine fills the limit with (:data:`WORK_SHARE`, :data:`SETUP_S`), to the
+    millisecond."""
+    work_s = max(WORK_SHARE * (time_limit_s - SETUP_S), LEAST_WORK_SHARE * time_limit_s)
+    return round(work_s, 3)  # as a client reads and sends it back
+
+
+@dataclass(frozen=True)
+class DefaultLimit:
+    """The time limit of a request that gives none: ``per_stop_s`` a stop, at least
+    ``least_s`` and at most ``most_s`` [s] — small rounds answer in about a second, large
+    fleets get the time a good plan of their size takes."""
+
+    per_stop_s: float
+    least_s: float
+    most_s: float
+
+    def __call__(self, data: dict[str, Any]) -> float:
+        """The limit for the request's fields validated so far (its ``stops`` among them)."""
+        stops = len(data.get("stops") or ())
+        return min(max(self.per_stop_s * stops, self.least_s), self.most_s)
+
+    def describe(self) -> str:
+        return (
+            f"absent: {self.per_stop_s:g} s a stop, at least {self.least_s:g} s and at most "
+            f"{self.most_s:g} s"
+        )
+
+
+#: A round's default limit: up to 20 stops in a second, 40 (and their charges) in 2 s, 200
+#: and more in 10 s.
+PLAN_TIME_LIMIT = DefaultLimit(per_stop_s=0.05, least_s=1.0, most_s=10.0)
+#: A fleet's: 6 s for 100 stops, a minute for 1,000 (what the Gehring–Homberger days and
+#: PyVRP at the same limit are measured at).
+FLEET_TIME_LIMIT = DefaultLimit(per_stop_s=0.06, least_s=1.0, most_s=60.0)
+
+
+def time_limit_field(default: DefaultLimit) -> float:
+    """The ``time_limit_s`` field of a problem with its default by size [s]."""
     return Field(
-        default_s,
+        default_factory=default,
         ge=MIN_TIME_LIMIT_S,
         le=MAX_TIME_LIMIT_S,
         description="The most the search may take [s], at least 0.01 s (capped by the server's "
-        "setting): a search the limit stops says so (solver.stopped_by: time_limit) and may "
-        "answer otherwise on a retry. Its work, unless work_s is given, is a tenth of it.",
+        f"setting); {default.describe()}. Its work, unless work_s is given, is "
+        f"{WORK_SHARE:.0%} of it less {SETUP_S:g} s (a search that does all its work gives the "
+        "same answer every time). A search the limit stops first says so (solver.stopped_by: "
+        "time_limit) and may answer otherwise on a retry; its solver.replay, sent back, gives "
+        "the same answer.",
     )
 
 
@@ -86,9 +129,50 @@ def cut_short(stopped_by: SearchEnd) -> list[str]:
         return []
     return [
         "the search was stopped by its time limit (time_limit_s) before its work (work_s) was "
-        "done: on a busy or slower machine the same request may give another plan; a longer "
-        "time_limit_s, or a smaller work_s, gives the same answer every time"
+        "done: on a busy or slower machine the same request may give another plan; sending "
+        "it again with this answer's solver.replay as its replay gives this plan again"
     ]
+
+
+class ReplayStop(Params):
+    """Where the clock stopped one search of a request."""
+
+    watch: int = Field(
+        ..., ge=0, le=10**9, description="Which look at the clock, in the order they were made."
+    )
+    at: int = Field(
+        ...,
+        ge=0,
+        le=2**53,
+        description="The count of its search's units (iterations, kicks, moves, solutions) "
+        "after which it stopped.",
+    )
+
+
+class Replay(Params):
+    """The work a request's searches did: sent back as the request's ``replay``, the same
+    searches do the same work again without looking at the clock — the same answer to the
+    byte (but its timing fields) on any machine, even one the time limit cut."""
+
+    request: str = Field(
+        ...,
+        pattern="^[0-9a-f]{64}$",
+        description="SHA-256 of the request it belongs to (every field but replay and "
+        "time_limit_s, as the server understood them): a replay of another request is refused.",
+    )
+    seed: int = Field(..., ge=0, le=2**31 - 1, description="The searches' seed.")
+    work_s: float = Field(
+        ...,
+        ge=0,
+        le=MAX_TIME_LIMIT_S,
+        description="The work the searches were given [reference s].",
+    )
+    stops: list[ReplayStop] = Field(
+        [],
+        max_length=100_000,
+        description="Each search the clock stopped before its work was done, and where "
+        "(empty: every search did all its work; the answer is then the same without replay).",
+    )
 
 
 class SearchFields(Params):
@@ -101,15 +185,75 @@ class SearchFields(Params):
         description="The search's work in reference seconds (what one core of the reference "
         "machine does in that time; kicks, iterations and deterministic time in each solver): "
         "the same amount of search on any machine and under any load, so the same answer. "
-        "Absent: a tenth of time_limit_s. Searches end earlier on a proof.",
+        f"Absent: {WORK_SHARE:.0%} of time_limit_s less {SETUP_S:g} s (at least "
+        f"{LEAST_WORK_SHARE:.0%} of it), what the reference machine fills the limit with. "
+        "Searches end earlier on a proof.",
     )
     seed: int = Field(0, ge=0, le=2**31 - 1, description="Seed of every search's randomness.")
+    replay: Replay | None = Field(
+        None,
+        description="An earlier answer's solver.replay, to do its searches' work again to "
+        "the byte without the clock (sent with the same request; time_limit_s does not cap it).",
+    )
+
+    def fingerprint(self) -> str:
+        """SHA-256 of the problem as the search sees it: every field but ``replay`` and
+        ``time_limit_s`` (which only caps the work) [hex] (0.2 s for 1,000 stops and their
+        matrix)."""
+        text = self.model_dump_json(exclude={"replay", "time_limit_s"})
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def work(self, time_limit_s: float) -> float:
+        """The search's work [reference s]: ``work_s``, or :func:`default_work_s`."""
+        return self.work_s if self.work_s is not None else default_work_s(time_limit_s)
+
+    def check_replay(self, time_limit_s: float, fingerprint: str | None = None) -> None:
+        """A ``replay`` of this very request (its ``fingerprint``, when known): the same
+        fingerprint, seed and work; raises :class:`core.exceptions.InvalidParameterError`
+        naming the field."""
+        replay = self.replay
+        if replay is None:
+            return
+        if replay.request != (fingerprint or self.fingerprint()):
+            raise InvalidParameterError(
+                "replay belongs to another request (its fingerprint differs): send it with the "
+                "request whose answer gave it, unchanged (time_limit_s too, unless work_s is "
+                "given: the work is a share of it)",
+                "replay.request",
+            )
+        if replay.seed != self.seed:
+            raise InvalidParameterError(f"replay.seed must equal seed ({self.seed})", "replay.seed")
+        if replay.work_s != self.work(time_limit_s):
+            raise InvalidParameterError(
+                f"replay.work_s must equal the request's work ({self.work(time_limit_s):g} s)",
+                "replay.work_s",
+            )
+        watches = [stop.watch for stop in replay.stops]
+        if len(set(watches)) != len(watches):
+            raise InvalidParameterError("replay.stops names a watch twice", "replay.stops")
 
     def effort(self, time_limit_s: float) -> Effort:
-        """The search's effort from now: its work (``work_s``, or :data:`WORK_SHARE` of
-        ``time_limit_s``), capped ``time_limit_s`` from now, with the seed."""
-        work_s = self.work_s if self.work_s is not None else WORK_SHARE * time_limit_s
-        return Effort.starting_now(work_s, time_limit_s, self.seed)
+        """The search's effort from now: its work (:meth:`work`), capped ``time_limit_s`` from
+        now, with the seed; replaying, stopped where the replay says instead. Its clock knows
+        the request's fingerprint (:func:`replay_of`)."""
+        fingerprint = self.fingerprint()
+        self.check_replay(time_limit_s, fingerprint)
+        replayed = None if self.replay is None else {s.watch: s.at for s in self.replay.stops}
+        return Effort.starting_now(
+            self.work(time_limit_s), time_limit_s, self.seed, replayed, fingerprint
+        )
+
+
+def replay_of(effort: Effort) -> Replay:
+    """What the searches under ``effort`` (:meth:`SearchFields.effort`) did, to replay them."""
+    clock = effort.clock
+    stops = clock.stops if clock.replayed is None else clock.replayed
+    return Replay(
+        request=clock.request,
+        seed=effort.seed,
+        work_s=effort.work_s,
+        stops=[ReplayStop(watch=k, at=at) for k, at in sorted(stops.items())],
+    )
 
 
 class RoundFields(Params):
@@ -300,7 +444,7 @@ class PlanFields(RoundFields, TripFields, StartFields, SearchFields):
         "first stop's window opens later).",
     )
     keep_order: bool = Field(False, description="Drive the stops in the given order.")
-    time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT_S)
+    time_limit_s: float = time_limit_field(PLAN_TIME_LIMIT)
     breaks: Breaks = breaks_field("none")
 
 
@@ -368,7 +512,7 @@ class FleetFields(RoundFields, SearchFields):
     minimize_vehicles: bool = Field(
         True, description="Fewer vans first, then the objective; false: the objective alone."
     )
-    time_limit_s: float = time_limit_field(FLEET_TIME_LIMIT_S)
+    time_limit_s: float = time_limit_field(FLEET_TIME_LIMIT)
 
 
 def vehicles_field() -> list[FleetVehicle]:
@@ -732,6 +876,12 @@ class Solved(Result):
         description="The parts of the answer that carry a proof: order (the stops' order is "
         "the optimum of the round trip) — also when charges or reloads were placed after it.",
     )
+    replay: Replay | None = Field(
+        None,
+        description="The work the searches did: sent back as the request's replay, the same "
+        "answer to the byte but for runtime_s (null in a fleet's routes: the fleet's is in "
+        "its solver).",
+    )
 
 
 @dataclass(frozen=True)
@@ -829,6 +979,8 @@ class FleetResult:
         re-solved after a failed verification).
     stopped_by
         How the searches stopped: their work done, or cut short by the time limit.
+    replay
+        The work the searches did, to do it again (:class:`Replay`).
     timezone, distance_source, warnings
         As in a round's result.
     """
@@ -848,6 +1000,7 @@ class FleetResult:
     distance_source: DistanceSource
     warnings: list[str]
     stopped_by: SearchEnd = "work"
+    replay: Replay | None = None
 
     @property
     def status(self) -> FleetStatus:

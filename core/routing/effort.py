@@ -1,21 +1,28 @@
 """How much a search may do: an amount of *work*, the same on any machine and under any load,
 and a deadline that only caps it.
 
-The same request gives the same answer only when its searches stop on work, not on the clock.
+The same request gives the same answer when its searches stop on work, not on the clock.
 The work is counted in *reference seconds*: what the solvers do in one second of one idle core
 of the project's reference machine (2 cores, x86-64), converted into each solver's own
 deterministic unit by the rates below — kicks of the round trip's local search, iterations of
 PyVRP, CP-SAT's deterministic time. A search that reaches the deadline first stops there and
-says so (``time_limit``): its answer may then differ on a retry.
+says so (``time_limit``). Every look at the clock that may stop a search is a :class:`Watch`:
+the :class:`Clock` shared by a request's searches records where each one stopped (the *n*-th
+watch, at the count of units its search had done), so that a replay — the same request with
+those records — stops every search at the same place, without the clock, on any machine: the
+same answer to the byte, even of a search the deadline cut.
 
 Rates, measured on the reference machine (uniform and clustered instances):
 
 - the round trip's local search (:mod:`core.routing.ils`): kicks per second by the number of
   places, interpolated log-log in :data:`KICKS_PER_S`;
-- PyVRP's iterated local search: ``3400 · (25 / clients)^0.6`` iterations per second with
-  every stop required (25 clients: 3,400; 100: 1,480; 1,000: 372), ``1800 · (25 /
-  clients)^0.6`` with every stop optional (25: 1,800; 100: 690; 1,000: 206), the marginal
-  rates over random VRPTW instances with tight and wide windows (the lower);
+- PyVRP's iterated local search: iterations per second by the number of clients, every
+  stop required, interpolated log-log in :data:`PYVRP_ITERATIONS_PER_S` (25: 5,200; 100:
+  1,950; 1,000: 480), :data:`PYVRP_OPTIONAL_SHARE` of that with every stop optional — about
+  a tenth below the slower end of what the fleet's model runs at on Solomon's and
+  Gehring–Homberger's instances (25 clients 5,400–6,200 a second; 100: R201 1,870, R101
+  2,130, C101 3,520; 1,000: R1_10_1 620, C1_10_1 1,360), so that a search of tight windows
+  and long routes ends within its time and one of clusters ends early;
 - OR-Tools' guided local search (:mod:`core.routing.vrp`): ``500 · (20 / places)^1.4``
   solutions per second (20 places: 500; 40: 190; 100: 52; 200: 20), on random instances with
   windows and an energy budget (long runs: the first solutions come faster);
@@ -28,7 +35,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Iterable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -39,12 +46,10 @@ SearchEnd = Literal["work", "proof", "time_limit"]
 #: Kicks per reference second of the round trip's local search, by places.
 KICKS_PER_S = ((20, 14_000), (40, 9_700), (80, 8_900), (150, 6_400), (300, 3_800),
                (600, 2_500), (1_000, 1_800))  # fmt: skip
-#: PyVRP's iterations per reference second: ``PYVRP_RATE · (PYVRP_SIZE / clients)^PYVRP_EXPONENT``
-#: with every stop required, ``PYVRP_OPTIONAL_RATE · …`` with every stop optional.
-PYVRP_RATE = 3_400.0
-PYVRP_OPTIONAL_RATE = 1_800.0
-PYVRP_SIZE = 25.0
-PYVRP_EXPONENT = 0.6
+#: PyVRP's iterations per reference second by clients, every stop required.
+PYVRP_ITERATIONS_PER_S = ((25, 5_200), (100, 1_950), (1_000, 480))
+#: The share of those with every stop optional (each a prize: a slower search).
+PYVRP_OPTIONAL_SHARE = 0.53
 #: OR-Tools' routing solutions per reference second:
 #: ``ORTOOLS_RATE · (ORTOOLS_SIZE / places)^ORTOOLS_EXPONENT``.
 ORTOOLS_RATE = 500.0
@@ -54,47 +59,120 @@ ORTOOLS_EXPONENT = 1.4
 CPSAT_DETERMINISTIC_PER_S = 0.3
 
 
+@dataclass
+class Clock:
+    """Where the deadline stopped a request's searches: ``stops`` maps the *n*-th watch made
+    (in the order the searches made them, the same on every run of the same work) to the count
+    of units its search had done when the clock stopped it. Replaying (``replayed`` given),
+    the clock is never read: each watch stops where the replayed record says, and nowhere
+    else. ``request``: what the searches solve (a fingerprint), for the record."""
+
+    replayed: dict[int, int] | None = None
+    request: str = ""
+    stops: dict[int, int] = field(default_factory=dict)
+    made: int = 0
+
+    @property
+    def replaying(self) -> bool:
+        return self.replayed is not None
+
+    def watch(self, deadline: float) -> Watch:
+        """The next watch, on ``deadline`` (a ``time.perf_counter`` value)."""
+        self.made += 1
+        return Watch(self, self.made - 1, deadline)
+
+
+@dataclass
+class Watch:
+    """One look at the clock that may stop a search, asked again as the search counts its
+    units (iterations, kicks, moves, places): :meth:`passed` says whether to stop now."""
+
+    clock: Clock
+    index: int
+    deadline: float
+
+    def passed(self, count: int) -> bool:
+        """Whether the search stops after ``count`` units (counts never go back): at the
+        deadline, recorded; replaying, where the record says."""
+        if self.clock.replayed is not None:
+            at = self.clock.replayed.get(self.index)
+            return at is not None and count >= at
+        if self.index in self.clock.stops:
+            return True
+        if time.perf_counter() < self.deadline:
+            return False
+        self.mark(count)
+        return True
+
+    def mark(self, count: int) -> None:
+        """Record that the clock stopped the search after ``count`` units, where the search
+        saw it itself (a solver's own time limit)."""
+        if self.clock.replayed is None:
+            self.clock.stops.setdefault(self.index, count)
+
+    def replayed_at(self) -> int | None:
+        """Replaying: the count after which the record stops the search (None: it ran its
+        work); None when not replaying — for a solver that counts and stops by itself."""
+        if self.clock.replayed is None:
+            return None
+        return self.clock.replayed.get(self.index)
+
+
 @dataclass(frozen=True)
 class Effort:
     """A search's work [reference s], the deadline that caps it (a ``time.perf_counter``
-    value) and its seed."""
+    value), its seed and the request's :class:`Clock`."""
 
     work_s: float
     deadline: float
     seed: int = 0
+    clock: Clock = field(default_factory=Clock, compare=False)
 
     @classmethod
-    def starting_now(cls, work_s: float, time_limit_s: float, seed: int = 0) -> Effort:
-        """``work_s`` of work, capped ``time_limit_s`` from now."""
-        return cls(work_s, time.perf_counter() + time_limit_s, seed)
+    def starting_now(
+        cls,
+        work_s: float,
+        time_limit_s: float,
+        seed: int = 0,
+        replayed: dict[int, int] | None = None,
+        request: str = "",
+    ) -> Effort:
+        """``work_s`` of work, capped ``time_limit_s`` from now; ``replayed``: where the
+        deadline stopped the same work of the same ``request`` before (:class:`Clock`), the
+        clock then unread."""
+        return cls(work_s, time.perf_counter() + time_limit_s, seed, Clock(replayed, request))
+
+    def watch(self) -> Watch:
+        """A new look at this effort's deadline."""
+        return self.clock.watch(self.deadline)
 
     def share(self, fraction: float) -> Effort:
         """A part of the work, under the same deadline."""
         return replace(self, work_s=self.work_s * fraction)
+
+    def within(self, fraction: float) -> Effort:
+        """The same work with its deadline at ``fraction`` of the time left from now."""
+        return replace(self, deadline=time.perf_counter() + self.left_s() * fraction)
 
     def keeping(self, reserve_s: float) -> Effort:
         """The same work with ``reserve_s`` [s] kept before the deadline for what follows."""
         return replace(self, deadline=self.deadline - reserve_s)
 
     def left_s(self) -> float:
-        """Time to the deadline [s]."""
+        """Time to the deadline [s]; replaying, without end (its watches stop the searches):
+        for solvers' own time limits and reserves, never to decide whether to stop."""
+        if self.clock.replaying:
+            return math.inf
         return self.deadline - time.perf_counter()
-
-    def out_of_time(self) -> bool:
-        return time.perf_counter() >= self.deadline
 
     def kicks(self, places: int) -> int:
         """The round trip's local search: kicks in this work."""
-        table = np.log(np.asarray(KICKS_PER_S, dtype=float))
-        rate = float(np.exp(np.interp(math.log(max(places, 2)), table[:, 0], table[:, 1])))
-        return max(int(self.work_s * rate), 0)
+        return max(int(self.work_s * _interpolated(KICKS_PER_S, places)), 0)
 
     def pyvrp_iterations(self, clients: int, optional: bool = False) -> int:
         """PyVRP's iterations in this work, its stops required or ``optional``."""
-        rate = (PYVRP_OPTIONAL_RATE if optional else PYVRP_RATE) * (
-            PYVRP_SIZE / max(clients, 1)
-        ) ** PYVRP_EXPONENT
-        return max(int(self.work_s * rate), 1)
+        rate = _interpolated(PYVRP_ITERATIONS_PER_S, clients)
+        return max(int(self.work_s * rate * (PYVRP_OPTIONAL_SHARE if optional else 1.0)), 1)
 
     def ortools_solutions(self, places: int) -> int:
         """OR-Tools' routing solutions in this work."""
@@ -104,6 +182,13 @@ class Effort:
     def cpsat_deterministic_time(self) -> float:
         """CP-SAT's deterministic time in this work."""
         return self.work_s * CPSAT_DETERMINISTIC_PER_S
+
+
+def _interpolated(table: tuple[tuple[int, int], ...], size: int) -> float:
+    """A rate of ``table`` (size, rate) at ``size``, log-log between its rows (its ends
+    beyond them)."""
+    logs = np.log(np.asarray(table, dtype=float))
+    return float(np.exp(np.interp(math.log(max(size, 2)), logs[:, 0], logs[:, 1])))
 
 
 def combined(ends: Iterable[SearchEnd]) -> SearchEnd:

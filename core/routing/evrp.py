@@ -42,7 +42,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pyvrp
-from pyvrp.stop import MaxIterations, MaxRuntime, MultipleCriteria
 
 from core.arrays import FloatArray
 from core.routing.effort import Effort, SearchEnd
@@ -311,17 +310,27 @@ def _customer_routes(instance: EvrpInstance, effort: Effort, charge_share: float
         [distance] * len(durations),  # type: ignore[list-item]  # PyVRP's stubs: ndarray[int]
         durations,
     )
-    stop = MultipleCriteria(
-        [
-            MaxIterations(effort.pyvrp_iterations(len(customers))),
-            MaxRuntime(max(effort.left_s(), 0.01)),
-        ]
+    result = pyvrp.solve(
+        data,
+        stop=_Iterations(effort.pyvrp_iterations(len(customers)), effort),
+        seed=effort.seed,
+        display=False,
     )
-    result = pyvrp.solve(data, stop=stop, seed=effort.seed, display=False)
     return [
         (route.vehicle_type(), [customers[v.idx] for v in route.schedule() if v.is_client()])
         for route in result.best.routes()
     ]
+
+
+class _Iterations:
+    """PyVRP's stopping criterion: its iterations, or the effort's deadline first."""
+
+    def __init__(self, iterations: int, effort: Effort) -> None:
+        self.iterations, self.watch, self.done = iterations, effort.watch(), 0
+
+    def __call__(self, best_cost: float) -> bool:
+        self.done += 1
+        return self.done > self.iterations or self.watch.passed(self.done)
 
 
 class _Priced:
@@ -592,12 +601,13 @@ class _Search(_Solution):
         end = self.spent_s + work_s
         nth = rounds = 0
         eliminating = 0.0
+        watch = effort.watch()
         while self.spent_s < end:
             rounds += 1
             for _ in range(DISTANCE_MOVES):
                 if self.spent_s >= end:
                     return "work"
-                if effort.out_of_time():
+                if watch.passed(self.moves):
                     return "time_limit"
                 self._ruin_and_recreate(START_THRESHOLD * (end - self.spent_s) / work_s)
                 self.keep_if_best()
@@ -638,7 +648,8 @@ class _Search(_Solution):
         if not all(self.insert(c, allow_new=False) for c in self._customers(out)):
             (self.routes, self.left), self.priced.penalty = saved, math.inf
             return False
-        while self.late() > 1e-9 and self.spent_s < until and not effort.out_of_time():
+        watch = effort.watch()
+        while self.late() > 1e-9 and self.spent_s < until and not watch.passed(self.moves):
             self._ruin_and_recreate(0.0, late_first=True)
         holds = self.late() <= 1e-9
         self.priced.penalty = math.inf
@@ -696,8 +707,9 @@ class _Search(_Solution):
         recreate, moving customers one by one, does not do: a van's last stretch, charges
         and all, handed to another)."""
         end = self.spent_s + work_s
+        watch = effort.watch()
         while self.spent_s < end:
-            if effort.out_of_time():
+            if watch.passed(self.moves):
                 return "time_limit"
             turned = any(self._turned_round(r) for r in range(len(self.routes)))
             if not turned and not self._ends_exchanged():

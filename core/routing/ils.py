@@ -21,12 +21,12 @@ The depot stays at position 0: every move leaves it there.
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 from scipy.sparse.csgraph import minimum_spanning_tree
+
+from core.routing.effort import Watch
 
 IntArray = NDArray[np.int64]
 
@@ -69,15 +69,14 @@ def iterated_local_search(
     cost: IntArray,
     order: list[int],
     kicks: int,
-    deadline: float,
+    watch: Watch,
     seed: int = 0,
     stall_kicks: int = 0,
 ) -> tuple[list[int], bool]:
     """The best tour from ``order`` (depot first and last) after ``kicks`` kicks, or once
-    ``stall_kicks`` kicks in a row brought nothing (0: no such stop), or at ``deadline`` (a
-    ``time.perf_counter`` value) if that comes first; and whether the deadline stopped it.
-    Seeded and in calls of :data:`CALL_KICKS`: the same answer whenever the deadline does
-    not stop it."""
+    ``stall_kicks`` kicks in a row brought nothing (0: no such stop), or when ``watch`` says
+    (between calls of :data:`CALL_KICKS`, counted) if that comes first; and whether it did.
+    Seeded: the same answer for the same calls."""
     n = cost.shape[0]
     if n < 5:
         return order, False
@@ -86,7 +85,7 @@ def iterated_local_search(
     tour = _local_search_all(cost, tour, near)
     stalled, call, done = 0, 0, 0
     while done < kicks and not (stall_kicks and stalled >= stall_kicks):
-        if time.perf_counter() >= deadline:
+        if watch.passed(call):
             return [*(int(x) for x in tour), 0], True
         batch = min(CALL_KICKS, kicks - done)
         tour, improved = _kicks(cost, tour, near, batch, seed + call)

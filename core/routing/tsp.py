@@ -173,7 +173,7 @@ def _improve(cost: NDArray[np.int64], start: list[int], effort: Effort) -> tuple
     kicks = effort.kicks(cost.shape[0]) // RUNS
     for run in range(RUNS):
         found, cut = iterated_local_search(
-            cost, start, kicks, effort.deadline, effort.seed + 1000 * run, STALL_KICKS
+            cost, start, kicks, effort.watch(), effort.seed + 1000 * run, STALL_KICKS
         )
         if tour_cost(cost, found) < tour_cost(cost, best):
             best = found
@@ -221,25 +221,30 @@ def _solve_exact(
     solver.parameters.linearization_level = 2
     solver.parameters.cp_model_presolve = False
     margin_s = _EXACT_STOP_MARGIN_S + _EXACT_STOP_MARGIN_PER_ARC_S * len(arcs)
-    budget_s = effort.left_s() - margin_s
-    if budget_s <= 0:
+    # 0: no time left to start; 1: its own time limit stopped it, and a search cut by the
+    # clock anywhere is no record to replay, so what it found is thrown away
+    watch = effort.keeping(margin_s).watch()
+    if watch.passed(0) or watch.replayed_at() == 1:
         return None, False, True
     work = effort.cpsat_deterministic_time()
     if work <= 0:
         return None, False, False
+    budget_s = effort.left_s() - margin_s
     solver.parameters.max_time_in_seconds = min(budget_s, 86_400.0)  # "never" is no number
     solver.parameters.max_deterministic_time = work
     solver.parameters.num_workers = 1
     solver.parameters.random_seed = effort.seed
     result = solver.solve(model)
-    cut = result != cp_model.OPTIMAL and solver.deterministic_time < work * 0.999
+    if result != cp_model.OPTIMAL and solver.deterministic_time < work * 0.999:
+        watch.mark(1)
+        return None, False, True
     if result not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
-        return None, False, cut
+        return None, False, False
     successor = {i: j for (i, j), var in arcs.items() if solver.boolean_value(var)}
     order = [0]
     while len(order) <= n:
         order.append(successor[order[-1]])
-    return order, result == cp_model.OPTIMAL, cut
+    return order, result == cp_model.OPTIMAL, False
 
 
 def _routing(cost: NDArray[np.int64]) -> tuple[pywrapcp.RoutingIndexManager, pywrapcp.RoutingModel]:

@@ -16,10 +16,9 @@ Two engines, each where it is strongest (``benchmarks/bench_fleet.py``):
    first (its fastest search: 2–3 times the iterations per second of one with optional
    stops); when that finds no routes serving them all within :data:`REQUIRED_SHARE` of its
    work, the rest of the work goes to a search with every stop optional for a prize, so a
-   partial plan is there. It ends after its work's iterations (:mod:`core.routing.effort`) or
-   :data:`ITERATIONS_PER_STOP` iterations per stop without improvement, whichever comes
-   first — seeded, so the same routes for the same input and effort — or, cut short, at the
-   deadline.
+   partial plan is there. It ends after its work's iterations (:mod:`core.routing.effort`) —
+   seeded, so the same routes for the same input and effort — or, cut short, at the deadline
+   (where it stopped is recorded, for a replay).
 2. OR-Tools' routing library with every constraint as a dimension, the energy budget
    included, and the cost of waiting for a window: it takes over PyVRP's routes when they
    break an energy budget (less the stops that do not fit) or when waiting has a cost,
@@ -43,8 +42,6 @@ from core.routing.effort import Effort, SearchEnd, combined
 
 IntMatrix = NDArray[np.int64]
 
-#: Iterations per stop without an improvement after which PyVRP ends before its work is done.
-ITERATIONS_PER_STOP = 200
 #: Share of PyVRP's work (and of its time) for finding routes that serve every stop before
 #: it searches with stops optional.
 REQUIRED_SHARE = 0.2
@@ -434,38 +431,30 @@ def _cost_scale(problem: RoutingInput, large_fixed: bool) -> float:
 
 
 class _Stop:
-    """PyVRP's stopping criterion: its iterations (the work), no improvement in ``patience``
-    iterations, or the deadline — and which of them stopped it. With ``give_up`` (iterations
-    and a ``time.perf_counter`` value), it also stops when either is reached and no solution
-    keeps every constraint yet; ``gave_up``: it stopped without one, but for the deadline."""
+    """PyVRP's stopping criterion: its iterations (the work), or the deadline (a
+    :class:`~core.routing.effort.Watch` on the iterations) — and which of them stopped it.
+    With ``give_up`` (iterations and an effort whose deadline comes earlier), it also stops
+    when either is reached and no solution keeps every constraint yet; ``gave_up``: it
+    stopped without one, but for the deadline."""
 
     def __init__(
-        self,
-        iterations: int,
-        patience: int,
-        deadline: float,
-        give_up: tuple[int, float] | None = None,
+        self, iterations: int, effort: Effort, give_up: tuple[int, Effort] | None = None
     ) -> None:
-        self.iterations, self.patience, self.deadline = iterations, patience, deadline
-        self.give_up = give_up
-        self.best, self.idle, self.done = math.inf, 0, 0
+        self.iterations, self.watch = iterations, effort.watch()
+        self.give_up = None if give_up is None else (give_up[0], give_up[1].watch())
+        self.done = 0
         self.ended: SearchEnd = "work"
         self.gave_up = False
 
     def __call__(self, best_cost: float) -> bool:
-        if best_cost < self.best:
-            self.best, self.idle = best_cost, 0
-        else:
-            self.idle += 1
         self.done += 1
-        now = time.perf_counter()
-        if now >= self.deadline:
+        if self.watch.passed(self.done):
             self.ended = "time_limit"
             return True
-        spent = self.done > self.iterations or self.idle > self.patience
+        spent = self.done > self.iterations
         if self.give_up is not None and best_cost >= _INFEASIBLE:
             iterations, moment = self.give_up
-            self.gave_up = spent or self.done > iterations or now >= moment
+            self.gave_up = spent or self.done > iterations or moment.passed(self.done)
             return self.gave_up
         return spent
 
@@ -473,21 +462,18 @@ class _Stop:
 def _pyvrp_routes(
     problem: RoutingInput, effort: Effort, initial: list[list[int]] | None
 ) -> tuple[list[list[int]] | None, SearchEnd]:
-    """PyVRP's best feasible routes per van after the effort's iterations (or
-    :data:`ITERATIONS_PER_STOP` per stop without improvement); None when it has none; and how
-    it stopped. Every stop required first; optional after :data:`REQUIRED_SHARE` of the work
-    or of the time left without routes that serve them all."""
-    if effort.out_of_time():
+    """PyVRP's best feasible routes per van after the effort's iterations; None when it has
+    none; and how it stopped. Every stop required first; optional after
+    :data:`REQUIRED_SHARE` of the work or of the time left without routes that serve them
+    all."""
+    if effort.watch().passed(0):
         return None, "time_limit"
     model = _pyvrp_model(problem, required=True)
     if not model.client_node:
         return [[] for _ in problem.vehicles], "work"
     clients = len(model.client_node)
     iterations = effort.pyvrp_iterations(clients)
-    give_up = (
-        int(iterations * REQUIRED_SHARE),
-        time.perf_counter() + effort.left_s() * REQUIRED_SHARE,
-    )
+    give_up = (int(iterations * REQUIRED_SHARE), effort.within(REQUIRED_SHARE))
     result, stop = _pyvrp_search(model, effort, iterations, initial, give_up)
     if stop.gave_up:
         model = _pyvrp_model(problem, required=False)
@@ -513,11 +499,10 @@ def _pyvrp_search(
     effort: Effort,
     iterations: int,
     initial: list[list[int]] | None,
-    give_up: tuple[int, float] | None = None,
+    give_up: tuple[int, Effort] | None = None,
 ) -> tuple[pyvrp.Result, _Stop]:
     """PyVRP's search on ``model`` for ``iterations`` under ``effort``'s deadline and seed."""
-    patience = ITERATIONS_PER_STOP * len(model.node_clients)
-    stop = _Stop(iterations, patience, effort.deadline, give_up)
+    stop = _Stop(iterations, effort, give_up)
     result = pyvrp.solve(
         model.data,
         stop=stop,
@@ -613,12 +598,20 @@ def _ortools_routes(
     params.local_search_metaheuristic = (
         routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
     )
-    params.solution_limit = effort.ortools_solutions(problem.travel_s.shape[0])
-    budget_s = effort.left_s() - _STOP_MARGIN_S
-    if budget_s <= 0:
+    # its own time limit stops it; the solutions it found by then are the record to replay
+    watch = effort.keeping(_STOP_MARGIN_S).watch()
+    if watch.passed(0):
         return None
-    params.time_limit.FromMilliseconds(max(int(min(budget_s, MAX_CAP_S) * 1000), 1))
+    replayed = watch.replayed_at()
+    if replayed == 0:  # cut before its first solution
+        return None
+    limit = effort.ortools_solutions(problem.travel_s.shape[0])
+    params.solution_limit = limit if replayed is None else replayed
+    budget_s = min(effort.left_s() - _STOP_MARGIN_S, MAX_CAP_S)
+    params.time_limit.FromMilliseconds(max(int(budget_s * 1000), 1))
     routing.CloseModelWithParameters(params)
+    found, started = [0], time.perf_counter()
+    routing.AddAtSolutionCallback(lambda: found.__setitem__(0, found[0] + 1))
     solution = None
     if initial is not None:
         start = routing.ReadAssignmentFromRoutes(
@@ -627,8 +620,12 @@ def _ortools_routes(
         if start is not None:
             solution = routing.SolveFromAssignmentWithParameters(start, params)
     if solution is None:
+        found[0] = 0
         solution = routing.SolveWithParameters(params)
-    ended: SearchEnd = "time_limit" if effort.out_of_time() else "work"
+    # fewer solutions than its limit, and (near enough) all its time: its time limit cut it
+    if replayed is None and found[0] < limit and time.perf_counter() - started >= budget_s * 0.9:
+        watch.mark(found[0])
+    ended: SearchEnd = "time_limit" if watch.passed(found[0]) else "work"
     if solution is None:
         return None
     routes: list[list[int]] = []

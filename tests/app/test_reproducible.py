@@ -22,6 +22,7 @@ from app.execution import WORKER_NICENESS
 from app.main import app
 from app.openapi_doc import RESPONSE_EXAMPLES
 from benchmarks.common import Server, busy_core
+from core.planning.model import default_work_s
 from tests.app.apps import app_client
 from tests.app.test_jobs import submit, wait_for
 
@@ -136,3 +137,79 @@ def test_a_search_the_time_limit_stops_says_so(client_default):
     done = client_default.post("/v1/plans", json=body | {"time_limit_s": 20, "work_s": 0.2}).json()
     assert done["solver"]["stopped_by"] in ("work", "proof")
     assert not any("stopped by its time limit" in w for w in done["warnings"])
+
+
+def without_replay(body: dict[str, Any]) -> dict[str, Any]:
+    """An example's request as a client first sends it: without the work it is pinned to."""
+    return {k: v for k, v in body.items() if k != "replay"}
+
+
+CUT = [
+    ("/v1/plans", "vienna-40-stops-depot-charger", {"time_limit_s": 0.3, "work_s": 20}),
+    ("/v1/fleet-plans", "vienna-two-vans", {"time_limit_s": 0.4, "work_s": 30}),
+]
+
+
+@pytest.mark.parametrize(("path", "name", "limits"), CUT, ids=[n for _, n, _ in CUT])
+def test_an_answer_the_time_limit_cut_is_replayed_to_the_byte_sync_and_as_a_job(
+    server, path, name, limits
+):
+    body = without_replay(dict(examples(path))[name]) | limits
+    response = httpx.post(f"{server.url}{path}", json=body, timeout=120)
+    first = response.json()
+    assert first["solver"]["stopped_by"] == "time_limit", first["solver"]
+    replay = first["solver"]["replay"]
+    assert replay["stops"] and replay["work_s"] == limits["work_s"]
+    # on a busier machine, and with a limit that would cut it at once: the same work again
+    with both_cores_busy():
+        again = httpx.post(
+            f"{server.url}{path}", json=body | {"replay": replay, "time_limit_s": 0.01}, timeout=120
+        ).json()
+    assert without_timing(again) == without_timing(first)
+    kind = "plan" if path == "/v1/plans" else "fleet-plan"
+    job = wait_for(
+        server.url,
+        submit(server.url, {"type": kind, "request": body | {"replay": replay}}).json()["id"],
+        timeout=120,
+    )
+    assert job["status"] == "succeeded", job
+    assert without_timing(job["result"]) == without_timing(first)
+
+
+def test_a_default_request_answers_the_same_or_replays_to_the_same(client_default):
+    """Without a time limit or work: the default for its size; done on its work, the same
+    answer every time; cut (a busy machine), its replay gives it again."""
+    body = without_replay(dict(examples("/v1/fleet-plans"))["vienna-two-vans"])
+    body.pop("time_limit_s")
+    first, second = (client_default.post("/v1/fleet-plans", json=body).json() for _ in range(2))
+    assert first["solver"]["replay"]["work_s"] == default_work_s(1.0)  # 10 stops: 1 s
+    for answer in (first, second):
+        if answer["solver"]["stopped_by"] == "time_limit":
+            replayed = client_default.post(
+                "/v1/fleet-plans", json=body | {"replay": answer["solver"]["replay"]}
+            ).json()
+            assert without_timing(replayed) == without_timing(answer)
+    if "time_limit" not in (first["solver"]["stopped_by"], second["solver"]["stopped_by"]):
+        assert without_timing(first) == without_timing(second)
+        assert first["solver"]["replay"]["stops"] == []
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        ({"seed": 5}, "replay.request"),  # another request (its seed is part of it)
+        ({"time_limit_s": 7.0}, "replay.request"),  # its work from another limit
+        ({"payload_kg": 500}, "replay.request"),
+    ],
+)
+def test_a_replay_of_another_request_is_refused_naming_it(client_default, change, field):
+    body = without_replay(dict(examples("/v1/plans"))["vienna-8-stops"]) | {"time_limit_s": 2.0}
+    replay = client_default.post("/v1/plans", json=body).json()["solver"]["replay"]
+    assert client_default.post("/v1/plans", json=body | {"replay": replay}).status_code == 200
+    refused = client_default.post("/v1/plans", json=body | change | {"replay": replay})
+    assert refused.status_code == 422, refused.text
+    assert [e["field"] for e in refused.json()["errors"]] == [field], refused.json()
+    forged = replay | {"seed": 3}
+    refused = client_default.post("/v1/plans", json=body | {"replay": forged})
+    assert refused.status_code == 422
+    assert [e["field"] for e in refused.json()["errors"]] == ["replay.seed"]

@@ -46,6 +46,7 @@ from core.planning.model import (
     Solved,
     check_places,
     cut_short,
+    replay_of,
 )
 from core.planning.round.reloads import check_payload, with_reloads
 from core.planning.search.day import VanShift, fleet_day, leg_roads
@@ -97,7 +98,7 @@ def plan(
     )
     windowed = any(stop.time_windows for stop in problem.stops)
     if windowed and not problem.keep_order:
-        return _in_windows(problem, scene, start, router, started, effort)
+        return _replayable(effort, _in_windows(problem, scene, start, router, started, effort))
     cost, unit_value, offset = cost_matrix(problem, legs, start)
     tours = _Tours(
         cost, len(places) - len(problem.chargers), problem.start_state is not None, effort
@@ -137,7 +138,12 @@ def plan(
     )
     solved = _how_solved(tour, result, scene.places, tours.ends)
     warnings = [*result.warnings, *cut_short(solved.stopped_by)]
-    return _in_time(problem, replace(result, solved=solved, warnings=warnings))
+    return _replayable(effort, _in_time(problem, replace(result, solved=solved, warnings=warnings)))
+
+
+def _replayable(effort: Effort, result: PlanResult) -> PlanResult:
+    """``result`` with the work its searches did under ``effort``, to replay them."""
+    return replace(result, solved=result.solved.model_copy(update={"replay": replay_of(effort)}))
 
 
 def _in_time(problem: PlanProblem, result: PlanResult) -> PlanResult:
@@ -278,11 +284,12 @@ def _check_reachable(problem: PlanProblem, places: list[Place], legs: Legs) -> N
 def check(problem: PlanProblem) -> tuple[dt.datetime, str]:
     """Everything about a round that can be checked without solving it — what a job refuses
     at submission as the synchronous endpoint does: unique stop ids, the payload, the time
-    zone and start time, the client's matrix, the start state. Raises
+    zone and start time, the client's matrix, the start state, a replay of another request. Raises
     :class:`core.exceptions.CoreError` naming the field; returns the departure (from the van's
     position when it is under way) and the zone's name."""
     check_places(problem)
     check_payload(problem)
+    problem.check_replay(problem.time_limit_s)
     start, timezone_name = round_start(problem)
     return check_start(problem, start.tzinfo) or start, timezone_name
 
