@@ -177,8 +177,13 @@ def _handler(
     return handle
 
 
+#: Errors that only follow from another: a default computed from fields that failed
+#: (``time_limit_s``'s, from the stops) is no error of the client's.
+_CONSEQUENCES = {"default_factory_not_called"}
+
+
 def _validation(_: Request, error: RequestValidationError) -> JSONResponse:
-    found = error.errors()
+    found = [e for e in error.errors() if e["type"] not in _CONSEQUENCES]
     errors = [
         {
             "field": _location(tuple(e["loc"]), e["type"], error.body),

@@ -61,9 +61,12 @@ gives the energy of one speed trace. `POST /v1/calibrations` fits the model to a
 trips (JSON, or CSV files at `/v1/calibrations/csv`), and `/v1/vehicle-profiles` keeps your vans by
 name — from a preset with changes or from a calibration — for any request's
 `"vehicle": {"profile": …}`. Units are in the field names (`_m`, `_s`, `_kwh`, `_c`...).
-Errors are `application/problem+json` (RFC 9457). The same request gives the same answer, byte
-for byte but the timing fields (`solver.runtime_s`): searches stop on their work (`work_s`,
-seeded by `seed`), and `time_limit_s` only caps them (`solver.stopped_by` says when it did).
+Errors are `application/problem+json` (RFC 9457). A search uses the time it is given
+(`time_limit_s`; absent: a default for the request's size), and the same request gives the same
+answer, byte for byte but the timing fields (`solver.runtime_s`): searches stop on their work
+(`work_s`, by default 85 % of the limit less 0.3 s; seeded by `seed`). When the limit stops one
+first (`solver.stopped_by: time_limit`, on a slow or busy machine), the answer's
+`solver.replay`, sent back as the request's `replay`, gives the same answer again.
 
 **[The plan viewer](/viewer)** plans a day from a CSV of stops and shows it: the routes on a map,
 the state of charge, the energy per consumer and the box temperature over the day.
