@@ -1,12 +1,19 @@
 """The full path template of a request ("/v1/jobs/{job_id}") and the methods documented there,
 read from the OpenAPI paths. (FastAPI's route objects hold their path relative to the router
-they were declared in, so ``scope["route"].path`` says "/plans" for "/v1/plans".)"""
+they were declared in, so ``scope["route"].path`` says "/plans" for "/v1/plans".) The pages
+outside the contract (the guide, the viewer, Swagger UI) have their methods from the router
+itself."""
 
 from __future__ import annotations
 
 import re
 from functools import cached_property
 from typing import Any
+
+from starlette.routing import Match
+
+#: The methods a path outside the OpenAPI document is tried with (HTTP's, RFC 9110, and PATCH).
+METHODS = ("GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS")
 
 
 class RouteTemplates:
@@ -37,10 +44,16 @@ class RouteTemplates:
         return None
 
     def methods(self, path: str) -> set[str]:
-        """Every method documented at ``path``."""
-        return {
+        """Every method documented at ``path``, or the router serves there (a page outside
+        the contract: the guide, the viewer)."""
+        documented = {
             method
             for pattern, _, methods in self._patterns
             if pattern.fullmatch(path)
             for method in methods
         }
+        return documented or {method for method in METHODS if self._routed(path, method)}
+
+    def _routed(self, path: str, method: str) -> bool:
+        scope = {"type": "http", "path": path, "method": method, "root_path": "", "headers": []}
+        return any(route.matches(scope)[0] == Match.FULL for route in self.app.router.routes)

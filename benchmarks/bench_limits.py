@@ -47,8 +47,7 @@ def solomon_day(name: str, customers: int) -> Instance:
 def as_users_send(instance: Instance) -> dict[str, Any]:
     """The day's request with nothing about the search: no time limit, no work."""
     body = fleet_request(instance, 0.0)
-    for name in ("time_limit_s", "work_s"):
-        body.pop(name)
+    body.pop("time_limit_s")
     return body
 
 

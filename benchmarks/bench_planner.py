@@ -13,7 +13,7 @@ import numpy as np
 
 from benchmarks.common import REFERENCE, busy_core, euc_2d_matrix, print_table
 from core.params import Depot, Stop
-from core.planning.model import PLAN_TIME_LIMIT_S, WORK_SHARE, PlanProblem
+from core.planning.model import PLAN_TIME_LIMIT, PlanProblem, default_work_s
 from core.planning.round.planner import plan
 from core.routing.effort import Effort
 from core.routing.tsp import solve_tour, tour_cost
@@ -41,10 +41,11 @@ def lkh_cost(cost: np.ndarray) -> int:
     return tour_cost(cost, order)
 
 
-def default_effort() -> Effort:
-    """A round's default search: :data:`WORK_SHARE` of the default time limit as work (a
-    reference second), that limit as its cap."""
-    return Effort.starting_now(WORK_SHARE * PLAN_TIME_LIMIT_S, PLAN_TIME_LIMIT_S)
+def default_effort(stops: int) -> Effort:
+    """A round's default search, as a request without time_limit_s or work_s gets it: the
+    default limit for its stops as its cap, the default work of that limit."""
+    limit_s = PLAN_TIME_LIMIT({"stops": range(stops)})
+    return Effort.starting_now(default_work_s(limit_s), limit_s)
 
 
 def round_quality() -> None:
@@ -53,7 +54,7 @@ def round_quality() -> None:
         started = time.perf_counter()
         theirs = lkh_cost(case.cost)
         their_s = time.perf_counter() - started
-        tour = solve_tour(case.cost, default_effort())
+        tour = solve_tour(case.cost, default_effort(case.cost.shape[0] - 1))
         gap = (tour.cost / theirs - 1) * 100
         gaps["clustered" if case.clusters > 1 else "uniform"].append(gap)
         rows.append(
@@ -68,8 +69,8 @@ def round_quality() -> None:
             ]
         )
     print_table(
-        "Delivery rounds at the default work (1 reference s) beside LKH-3 (elkai, 10 runs), "
-        "same run",
+        "Delivery rounds at the default limit and work for their size (as a request without "
+        "time_limit_s) beside LKH-3 (elkai, 10 runs), same run",
         ["round", "ours [m]", "LKH-3 [m]", "gap", "status", "our time [ms]", "LKH time [ms]"],
         rows,
     )
@@ -92,7 +93,7 @@ def tsp_quality(loaded: bool) -> None:
     ):
         for entry in csv.DictReader((REFERENCE / folder / index).open()):
             cost = euc_2d_matrix(REFERENCE / folder / f"{entry['name']}.tsp")
-            tour = solve_tour(cost, default_effort())
+            tour = solve_tour(cost, default_effort(cost.shape[0] - 1))
             reference = int(entry[column])
             gap = (tour.cost / reference - 1) * 100
             n = int(entry["n"])

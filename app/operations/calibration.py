@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from app.operations.cells import delimiter_of, number
+from app.operations.cells import delimiter_of, header_of, number
 from app.operations.vans import van_of
 from app.profiles import profile_store
 from app.schemas.calibration import (
@@ -133,14 +133,12 @@ def csv_columns(text: str, field: str) -> dict[str, list[float]]:
         raise InvalidParameterError("the CSV has no header row", field)
     delimiter = delimiter_of(lines[0])
     rows = list(csv.reader(lines, delimiter=delimiter))
-    header = [cell.strip() for cell in rows[0]]
+    header = header_of(rows[0], field)
     for name in header:
         if name not in CSV_COLUMNS:
             raise InvalidParameterError(
                 f"unknown column {name[:40]!r}; the columns are {', '.join(CSV_COLUMNS)}", field
             )
-    if len(set(header)) != len(header):
-        raise InvalidParameterError("a column is named twice in the header row", field)
     columns: dict[str, list[float]] = {name: [] for name in header}
     samples = [row for row in rows[1:] if any(cell.strip() for cell in row)]
     for index, row in enumerate(samples):

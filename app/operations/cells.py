@@ -15,6 +15,18 @@ def delimiter_of(header: str) -> str:
     return ";" if header.count(";") > header.count(",") else ","
 
 
+def header_of(row: list[str], field: str) -> list[str]:
+    """The column names of a header row, trimmed; a name twice is an error naming ``field``
+    (which column would a reader take? the last, silently, gave stops at latitude 0)."""
+    header = [cell.strip() for cell in row]
+    twice = next((name for k, name in enumerate(header) if name in header[:k]), None)
+    if twice is not None:
+        raise InvalidParameterError(
+            f"the column {twice[:40]!r} is named twice in the header row", field
+        )
+    return header
+
+
 #: A number as a spreadsheet writes one: ASCII digits, one point, an exponent. Python's
 #: float() also reads ``1_0`` and other scripts' digits (``١٠``) as 10: not a telematics cell.
 _CSV_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")

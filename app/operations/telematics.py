@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from pydantic import ValidationError
 
-from app.operations.cells import delimiter_of, number
+from app.operations.cells import delimiter_of, header_of, number
 from core.exceptions import InvalidParameterError
 from core.params import Location
 from core.routing.geo import metres_from
@@ -98,7 +98,7 @@ def _lines(text: str) -> tuple[list[_Line], bool]:
         raise InvalidParameterError("the CSV has no header row", "history")
     delimiter = delimiter_of(rows[0])
     table = list(csv.reader(rows, delimiter=delimiter))
-    header = [cell.strip() for cell in table[0]]
+    header = header_of(table[0], "history")
     traces = "time" in header and "stop_id" not in header
     missing = [name for name in (TRACE if traces else REQUIRED) if name not in header]
     if missing:

@@ -162,6 +162,9 @@ def stretch_to_duration(speed_mps: FloatArray, dt_s: float, duration_s: float) -
     return stretched * (distance / total) if total > 0 else stretched
 
 
+#: The shortest leg driven [m]: shorter is standing still (a micrometre; a leg of 5e-324 m
+#: has a trace whose distance is no number to scale by).
+LEAST_DRIVEN_M = 1e-6
 #: How much steeper than the van's acceleration a sampled ramp may come out [–]: sampling a
 #: trapezoid's corners on whole steps and scaling it to its distance adds up to a few per cent.
 RAMP_TOLERANCE = 0.05
@@ -187,7 +190,7 @@ def rest_to_rest(
     accel_mps2, top_mps
         The van's acceleration (and deceleration) [m/s²] and top speed [m/s].
     """
-    if distance_m <= 0:
+    if distance_m < LEAST_DRIVEN_M:  # no drive (a subnormal number's trace has no distance)
         return np.zeros(max(round(duration_s / dt_s), 0) + 1)
     least_s = float(fastest_s(distance_m, accel_mps2, top_mps))
     steps = max(math.ceil(max(duration_s, least_s) / dt_s - 1e-9), 2)
@@ -203,7 +206,9 @@ def _trapezoid(distance_m: float, total_s: float, accel_mps2: float, dt_s: float
     """Accelerate, cruise, brake over ``total_s`` (a whole number of ``dt_s``, no less than
     the least time), sampled every ``dt_s`` and scaled to cover ``distance_m`` exactly."""
     a = accel_mps2
-    cruise = (a * total_s - math.sqrt(max(a * a * total_s * total_s - 4 * a * distance_m, 0.0))) / 2
+    # v = (a·T − √(a²T² − 4·a·d))/2, written without the difference of two near numbers
+    root = math.sqrt(max(a * a * total_s * total_s - 4 * a * distance_m, 0.0))
+    cruise = 2 * a * distance_m / (a * total_s + root)
     ramp_s = cruise / a
     times = np.array([0.0, ramp_s, total_s - ramp_s, total_s])
     grid = np.arange(round(total_s / dt_s) + 1) * dt_s

@@ -356,3 +356,17 @@ def test_the_real_server_writes_one_json_line_per_request():
     assert entry["route"] == "/v1/plans" and entry["status"] == 200
     assert entry["method"] == "POST" and entry["duration_ms"] > 0
     assert not any('HTTP/1.1" 200' in line for line in lines)  # uvicorn's access log is off
+
+
+@pytest.mark.parametrize(
+    ("path", "body"), [("/v1/plans", PLAN_EXAMPLE), ("/v1/fleet-plans", FLEET_PLAN_EXAMPLE)]
+)
+def test_a_matrix_of_subnormal_numbers_is_a_day_of_standing_still(client, path, body):
+    # 5e-324 m in 5e-324 s everywhere (an audit's): no drive, so no energy to drive — an
+    # answer, not an internal error (a trace of that distance had none to scale by)
+    n = len(body["stops"]) + 1
+    tiny = [[0.0 if i == j else 5e-324 for j in range(n)] for i in range(n)]
+    answer = client.post(path, json=body | {"matrix": {"distances_m": tiny, "durations_s": tiny}})
+    assert answer.status_code == 200, answer.text[:300]
+    routes = answer.json().get("routes", [answer.json()])
+    assert routes and all(leg["energy_kwh"]["traction"] == 0.0 for r in routes for leg in r["legs"])

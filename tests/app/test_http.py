@@ -49,6 +49,10 @@ def made_up_methods(n: int, seed: int = 21) -> list[str]:
         ("/healthz", "GET"),
         ("/v1/jobs", "GET, POST"),
         ("/v1/jobs/some-id", "DELETE, GET"),
+        # pages outside the contract: the router's methods (an audit found an empty Allow)
+        ("/guide/", "GET, HEAD"),
+        ("/guide/integrators/index.html", "GET, HEAD"),
+        ("/viewer", "GET"),
     ],
 )
 def test_a_made_up_method_is_a_405_naming_the_paths_methods_without_a_key(secured, path, allowed):
@@ -80,9 +84,12 @@ def test_made_up_methods_do_not_grow_the_metrics(secured):
     assert metric("\n".join(after), series) == metric("\n".join(before), series) + 25
 
 
-def test_a_known_method_on_a_path_without_it_is_a_405_naming_the_allowed(client):
-    response = client.request("PATCH", "/v1/plans")
-    assert response.status_code == 405 and response.headers["allow"] == "POST"
+@pytest.mark.parametrize(
+    ("path", "allowed"), [("/v1/plans", "POST"), ("/guide/", "GET, HEAD"), ("/viewer", "GET")]
+)
+def test_a_known_method_on_a_path_without_it_is_a_405_naming_the_allowed(client, path, allowed):
+    response = client.request("PATCH", path)
+    assert response.status_code == 405 and response.headers["allow"] == allowed
 
 
 # --- credentials and headers -------------------------------------------------------------------

@@ -89,6 +89,16 @@ def test_a_bad_export_names_the_line_and_the_column(rows, field, words):
     assert error["field"] == field and words in error["message"], error
 
 
+@pytest.mark.parametrize("twice", ["lat", "stop_id"])
+def test_a_column_named_twice_is_named_not_read_twice(twice):
+    # an audit's export had lat twice: the last copy won and every stop was at latitude 0.0
+    rows = [f"{row},{row.split(',')[HEADER.split(',').index(twice)]}" for row in ROWS]
+    response = send(rows, header=f"{HEADER},{twice}")
+    assert response.status_code == 422, response.text
+    error = response.json()["errors"][0]
+    assert error["field"] == "history" and f"'{twice}' is named twice" in error["message"]
+
+
 def test_a_header_without_a_column_and_a_study_with_days_of_its_own_are_named():
     missing = send(ROWS, header=HEADER.replace("arrival,", ""))
     assert missing.status_code == 422

@@ -221,3 +221,16 @@ def test_rest_to_rest_keeps_the_distance_within_the_vans_limits(distance, durati
     # no longer than the time asked for, or the least the van needs, by more than a step or two
     least = fastest_s(distance, accel, top)
     assert trace.size - 1 <= max(duration, least) * (1 + RAMP_TOLERANCE) + 2
+
+
+@pytest.mark.parametrize("distance", [5e-324, 1e-310, 1e-9, 1e-7])
+def test_a_leg_shorter_than_a_micrometre_stands_still(distance):
+    trace = rest_to_rest(distance, 60.0, 1.0, 30.0)
+    assert trace.size == 61 and not trace.any()
+
+
+@pytest.mark.parametrize("distance", [1e-6, 1e-3, 1.0])
+def test_a_short_leg_over_a_long_time_covers_its_distance(distance):
+    # the cruise speed from 2·a·d / (a·T + √(a²T² − 4·a·d)): no cancellation at a²T² ≫ 4·a·d
+    trace = rest_to_rest(distance, 3600.0, 2.0, 30.0)
+    assert trace_distance_m(trace, 1.0) == pytest.approx(distance, rel=1e-9)
