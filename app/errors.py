@@ -20,7 +20,7 @@ from core.exceptions import (
     ServiceUnavailableError,
     TooMuchToWaitForError,
 )
-from core.params import BRANCH_TAG
+from core.params import BRANCH_TAG, plain_rule
 
 PROBLEM_JSON = "application/problem+json"
 E = TypeVar("E", bound=Exception)
@@ -161,7 +161,7 @@ def _message(error: Any) -> str:
         position = error["loc"][-1] if error["loc"] else "?"
         reason = (error.get("ctx") or {}).get("error", "invalid JSON")
         return f"the body is not valid JSON at character {position}: {reason}"
-    return _echo(str(error["msg"]), MAX_ECHO_MESSAGE)
+    return _echo(plain_rule(error), MAX_ECHO_MESSAGE)
 
 
 def _handler(

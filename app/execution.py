@@ -21,6 +21,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import ctypes
+import logging
 import multiprocessing
 import os
 import signal
@@ -39,6 +40,7 @@ from app.settings import Settings
 from core.arrays import keep_heap
 
 T = TypeVar("T")
+_log = logging.getLogger("coldroute.workers")
 #: Nice increment of the workers: the server's event loop comes first on a busy machine.
 WORKER_NICENESS = 5
 #: How often a waiting request checks for a free worker, its client and the shutdown [s].
@@ -131,9 +133,22 @@ class WorkerPool:
         self, fn: Callable[..., T], args: tuple[Any, ...], timeout_s: float | None = None
     ) -> Future[T]:
         """Run ``fn(*args)`` in a worker; its future, which ``cancel()`` stops (Pebble
-        terminates the process) and which fails with ``TimeoutError`` after ``timeout_s``."""
+        terminates the process) and which fails with ``TimeoutError`` after ``timeout_s``.
+        A pool a dead worker broke is replaced first (:meth:`repaired`)."""
+        self.repaired()
         future: Future[T] = self._processes.schedule(fn, args=args, timeout=timeout_s)
         return future
+
+    def repaired(self) -> bool:
+        """Whether the pool runs or is yet to start, after replacing one that broke: Pebble
+        marks its whole pool broken when a worker dies while idle (the kernel's out-of-memory
+        killer, a kill -9), and every later task fails — so a broken pool is stopped and a new
+        one starts in its place (its processes on first use)."""
+        if self._pool is None or self._pool.active:
+            return True
+        _log.warning("a worker process died while idle; starting the worker pool again")
+        self.stop()
+        return self._processes.active
 
     def warm(self, load: Callable[[], object] = ping) -> None:
         """Start every process and have it run ``load`` (about 2 s, once): a worker that
@@ -182,8 +197,8 @@ class Executor:
         await asyncio.gather(*(asyncio.wrap_future(future) for future in futures))
 
     def alive(self) -> bool:
-        """Whether the pool runs and takes work."""
-        return not self._stopped and self.pool.active
+        """Whether the pool runs and takes work (a broken one replaced first)."""
+        return not self._stopped and self.pool.repaired() and self.pool.active
 
     async def run(
         self,
@@ -206,6 +221,12 @@ class Executor:
             )
         await self._acquire(disconnected, self.settings.queue_deadline_s)
         try:
+            try:
+                return await self._await(self._schedule(fn, args))
+            except RuntimeError:
+                if self.pool.active:  # fn's own error
+                    raise
+            # the pool broke under it (a worker died while idle): once more on a new one
             return await self._await(self._schedule(fn, args))
         finally:
             self._slots().release()

@@ -71,7 +71,10 @@ def _celery(broker_url: str, queue: str, visibility_s: int) -> Celery:
             "socket_timeout": 5,
         },
     )
-    app.task(bind=True, name=TASK)(_run_job)
+    # no limit on its retries: a claim the database refused is retried until the database is
+    # back (retry()'s max_retries=None means the task's default, which was Celery's 3: a
+    # claim dropped after 6 s of outage waited for the servers' resend, 85-102 s)
+    app.task(bind=True, name=TASK, max_retries=None)(_run_job)
     app.task(bind=True, name=HELP_TASK)(_help_job)
     return app
 
@@ -95,7 +98,7 @@ def _run_job(task: Task, job_id: str) -> str:
     except OperationalError as error:
         # The database is away: this message comes back in a moment, not when the servers
         # resend it (minutes); the attempt is not counted, as nothing was claimed.
-        raise task.retry(countdown=DATABASE_RETRY_S, max_retries=None, exc=error) from None
+        raise task.retry(countdown=DATABASE_RETRY_S, exc=error) from None
     if job is None:
         return "not queued (done, cancelled, waiting for a retry or running elsewhere)"
     if JOB_KINDS[job.type].fanout is not None:

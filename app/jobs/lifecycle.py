@@ -142,6 +142,10 @@ class Lifecycle:
                 future.cancel()  # Pebble stops the worker process
                 return "cancelled"
 
+    def not_started(self, job: JobView) -> None:
+        """Put back a job claimed here that could not be started (not counted as a run)."""
+        self.stored(lambda: self.store.requeue(job.id, self.runner, count=False))
+
     def stored(self, write: Callable[[], object]) -> None:
         """Record an ending, waiting out a database that is away (every heartbeat period, up
         to :data:`DATABASE_PATIENCE_S`; then the job's heartbeat is stale and it runs again)."""

@@ -82,7 +82,12 @@ class LocalRunner:
             watch = asyncio.create_task(asyncio.to_thread(parted.coordinate, job))
             watch.add_done_callback(lambda _: self.executor.release())
         else:
-            future = self.executor.start(run_job, job.type, job.request, self.settings)
+            try:
+                future = self.executor.start(run_job, job.type, job.request, self.settings)
+            except BaseException:  # not started: its worker free, the job queued again
+                self.executor.release()
+                await asyncio.to_thread(self.lifecycle.not_started, job)
+                raise
             watch = asyncio.create_task(asyncio.to_thread(self.lifecycle.watch, job, future))
         self.watching.add(watch)
         watch.add_done_callback(self._ended)

@@ -31,6 +31,7 @@ from core.params import (
     field_path,
     get_preset,
     inside_validation,
+    plain_rule,
 )
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import DayWeather, WeatherSource
@@ -229,7 +230,7 @@ class VanRequest(ApiModel):
             except ValidationError as error:
                 for item in error.errors():
                     path = field_path(item["loc"])
-                    details.append((f"{section}.{path}" if path else section, item["msg"]))
+                    details.append((f"{section}.{path}" if path else section, plain_rule(item)))
         if details:
             message = "; ".join(f"{field}: {rule}" for field, rule in details)
             raise InvalidParameterError(message, details[0][0], details)
@@ -249,7 +250,7 @@ class VanRequest(ApiModel):
                     refrigeration=refrigeration,
                 )
         except ValidationError as error:
-            rules = [(field_path(item["loc"]), item["msg"]) for item in error.errors()]
+            rules = [(field_path(item["loc"]), plain_rule(item)) for item in error.errors()]
             message = "; ".join(f"{field}: {rule}" for field, rule in rules)
             raise InvalidParameterError(message, rules[0][0], rules) from None
 

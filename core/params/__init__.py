@@ -26,6 +26,7 @@ from core.params.base import (
     few_unknown,
     field_path,
     inside_validation,
+    plain_rule,
 )
 from core.params.conditions import (
     AGGRESSIVE_DRIVER,
@@ -132,5 +133,6 @@ __all__ = [
     "field_path",
     "get_preset",
     "inside_validation",
+    "plain_rule",
     "product_band",
 ]

@@ -121,12 +121,28 @@ def field_path(loc: Sequence[int | str]) -> str:
     return path
 
 
+#: What pydantic puts before a validator's own words.
+_RULE_PREFIXES = ("Value error, ", "Assertion failed, ")
+#: Pydantic's errors that name a class of ours ("a valid dictionary or instance of Weekdays").
+_OBJECT_EXPECTED = frozenset({"model_type", "model_attributes_type", "dataclass_type"})
+
+
+def plain_rule(item: Any) -> str:
+    """A pydantic error's rule in the request's words: no class names, no "Value error, "."""
+    if item["type"] in _OBJECT_EXPECTED:
+        return "must be an object ({…}) with the fields the schema names"
+    rule = str(item["msg"])
+    for prefix in _RULE_PREFIXES:
+        rule = rule.removeprefix(prefix)
+    return rule
+
+
 def describe_validation_error(error: ValidationError, prefix: str = "") -> str:
-    """One line per pydantic error: ``field.path: rule``."""
+    """One line per pydantic error: ``field.path: rule`` (:func:`plain_rule`)."""
     parts = []
     for item in error.errors():
         path = field_path((prefix, *item["loc"]))
-        parts.append(f"{path or 'input'}: {item['msg']}")
+        parts.append(f"{path or 'input'}: {plain_rule(item)}")
     return "; ".join(parts)
 
 
@@ -200,6 +216,5 @@ class Params(BaseModel):
         except ValidationError as error:
             first = error.errors()[0]["loc"]
             raise InvalidParameterError(
-                describe_validation_error(error, type(self).__name__),
-                field=field_path(first) or None,
+                describe_validation_error(error), field=field_path(first) or None
             ) from None

@@ -24,12 +24,14 @@ from app.jobs.celery_app import celery_for, visibility_timeout_s
 from app.jobs.lifecycle import JOB_EXTRA_TIME_S
 from app.jobs.store import JobStore
 from app.settings import Settings
-from benchmarks.common import Server
-from tests.app.serving import alive, children, long_plan
+from benchmarks.common import Server, children
+from tests.app.serving import alive, long_plan
 from tests.app.test_celery import Worker, own_services
 from tests.app.test_jobs import FAST, submit, wait_for
 from tests.utils.tcp_proxy import TcpProxy
 
+#: How long PostgreSQL is away in the outage test [s]: longer than Celery's default retries.
+DATABASE_OUTAGE_S = 30
 #: Loopback only, and nothing kept on disk.
 REDIS_SERVER = ["redis-server", "--bind", "127.0.0.1", "--save", "", "--appendonly", "no"]
 
@@ -263,8 +265,10 @@ def test_a_database_outage_costs_no_attempt_and_delays_nothing_beyond_it():
     """The fault audit: with PostgreSQL away, a Celery worker kept taking messages, failed to
     claim their jobs and dropped them: queued jobs ran only when the servers resent them,
     80 s after the database came back, and the jobs running through the outage each lost an
-    attempt. PostgreSQL (the machines' own) is cut off behind a proxy for 8 s while a job
-    runs and three wait: every job runs once, within seconds of the database's return."""
+    attempt; after the first fix, an outage longer than Celery's default three retries (6 s)
+    still dropped the claims (queued jobs started 85–102 s after a 20–35 s outage).
+    PostgreSQL (the machines' own) is cut off behind a proxy for 30 s while a job runs and
+    three wait: every job runs once, the queued ones starting within 10 s of its return."""
     proxy = TcpProxy(("127.0.0.1", 5432))
     try:
         with own_services() as env:
@@ -284,11 +288,10 @@ def test_a_database_outage_costs_no_attempt_and_delays_nothing_beyond_it():
                     for _ in range(3)
                 ]
                 proxy.cut()
-                time.sleep(8)
+                time.sleep(DATABASE_OUTAGE_S)
                 proxy.mend()
-                back = time.monotonic()
-                done = [wait_for(server.url, job, timeout=90) for job in [running_id, *queued]]
-                took_s = time.monotonic() - back
+                back = dt.datetime.now(dt.UTC)
+                done = [wait_for(server.url, job, timeout=120) for job in [running_id, *queued]]
             finally:
                 worker.stop()
                 server.close()
@@ -296,7 +299,10 @@ def test_a_database_outage_costs_no_attempt_and_delays_nothing_beyond_it():
         proxy.close()
     assert [job["status"] for job in done] == ["succeeded"] * 4, done
     assert [job["attempts"] for job in done] == [1] * 4
-    assert took_s < 30, took_s  # the servers' resend would have taken 80 s
+    started_s = [
+        (dt.datetime.fromisoformat(job["started_at"]) - back).total_seconds() for job in done[1:]
+    ]
+    assert max(started_s) < 10, started_s  # the servers' resend would have taken 80 s
 
 
 def test_sigterm_with_no_request_in_flight_lets_a_short_job_finish():
@@ -360,3 +366,57 @@ def test_sigkill_of_a_celery_worker_takes_its_solvers_along(broker, services):
         server.close()
         with contextlib.suppress(ProcessLookupError):
             os.killpg(worker.process.pid, signal.SIGKILL)
+
+
+def solvers(pid: int) -> list[int]:
+    """The worker processes of the server or Celery worker ``pid`` (not its resource
+    tracker)."""
+    found = []
+    for child in children(pid):
+        with contextlib.suppress(OSError):
+            command = Path(f"/proc/{child}/cmdline").read_bytes()
+            if b"spawn_main" in command and b"resource_tracker" not in command:
+                found.append(child)
+    return found
+
+
+def kill_one_idle(pid: int) -> None:
+    """SIGKILL one of ``pid``'s idle worker processes (what the kernel's out-of-memory killer
+    does), and wait until it is gone."""
+    idle = solvers(pid)
+    assert idle, "no worker process to kill"
+    os.kill(idle[0], signal.SIGKILL)
+    assert wait_gone(idle[:1], within_s=10.0) == []
+
+
+def test_a_worker_killed_while_idle_is_replaced_and_the_next_request_answers():
+    """The audit: kill -9 of one idle worker broke the whole pool (Pebble marks it broken),
+    POST /v1/plans answered 500, then 503 for good, jobs stayed queued and /readyz kept 200."""
+    server = Server({"COLDROUTE_WORKERS": "2"}).start()
+    try:
+        assert httpx.post(f"{server.url}/v1/plans", json=PLAN_EXAMPLE, timeout=60).is_success
+        for _ in range(2):  # twice: a new pool's worker too
+            kill_one_idle(server.process.pid)
+            answer = httpx.post(f"{server.url}/v1/plans", json=PLAN_EXAMPLE, timeout=60)
+            assert answer.status_code == 200, answer.text[:300]
+            status, checks = readiness(server.url)
+            assert status == 200 and checks["workers"]["ok"], checks
+            job_id = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+            job = wait_for(server.url, job_id, timeout=60)
+            assert job["status"] == "succeeded" and job["attempts"] == 1, job
+    finally:
+        server.close()
+
+
+def test_a_celery_workers_process_killed_while_idle_is_replaced(broker, services):
+    worker = Worker(services, "replaced")
+    server = Server(services).start()
+    try:
+        for _ in range(2):  # the first job starts the worker's processes
+            job_id = submit(server.url, {"type": "plan", "request": PLAN_EXAMPLE}).json()["id"]
+            job = wait_for(server.url, job_id, timeout=90)
+            assert job["status"] == "succeeded" and job["attempts"] == 1, job
+            kill_one_idle(worker.process.pid)
+    finally:
+        worker.stop()
+        server.close()

@@ -11,6 +11,7 @@ import httpx
 import pytest
 
 from app.examples import (
+    ELECTRIFICATION_EXAMPLE,
     FLEET_PLAN_EXAMPLE,
     PLAN_EXAMPLE,
     SCENARIOS_EXAMPLE,
@@ -370,3 +371,27 @@ def test_a_matrix_of_subnormal_numbers_is_a_day_of_standing_still(client, path, 
     assert answer.status_code == 200, answer.text[:300]
     routes = answer.json().get("routes", [answer.json()])
     assert routes and all(leg["energy_kwh"]["traction"] == 0.0 for r in routes for leg in r["legs"])
+
+
+@pytest.mark.parametrize(
+    ("path", "body", "field"),
+    [
+        ("/v1/plans", PLAN_EXAMPLE | {"weather": 5}, "weather"),
+        ("/v1/plans", PLAN_EXAMPLE | {"cargo_box": {"product": 7}}, "cargo_box.product"),
+        (
+            "/v1/studies/electrification",
+            ELECTRIFICATION_EXAMPLE
+            | {"routes": [ELECTRIFICATION_EXAMPLE["routes"][0] | {"days": 5}]},
+            "routes[0].days",
+        ),
+        ("/v1/plans", PLAN_EXAMPLE | {"refrigeration": {"strategy": "optimal"}}, "refrigeration"),
+    ],
+)
+def test_messages_speak_of_the_request_not_of_the_code(client, path, body, field):
+    # an audit read "instance of Weekdays / DrivenDay / ProductBand" and "VanParams.refrigeration:
+    # Value error, …": names of the code's classes and the framework's words
+    response = client.post(path, json=body)
+    assert response.status_code == 422 and field in fields(response), response.text
+    text = response.text
+    for word in ("instance of", "Value error", "VanParams", "Weekdays", "ProductBand"):
+        assert word not in text, (word, text)

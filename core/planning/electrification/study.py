@@ -22,7 +22,7 @@ from pydantic import ValidationError
 
 from core.clock import departure
 from core.exceptions import CoreError, InvalidParameterError, ServiceUnavailableError
-from core.params import Location, Stop, VanParams, product_band
+from core.params import Location, Stop, VanParams, plain_rule, product_band
 from core.physics.battery import BatteryVerdict
 from core.physics.cold_chain import check_cold_chain
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
@@ -289,7 +289,7 @@ def carrying(van: VanParams, route: DrivenRoute) -> VanParams:
     try:
         return VanParams.model_validate(van.model_dump() | {"cargo_box": box.model_dump()})
     except ValidationError as error:
-        rule = error.errors()[0]["msg"].removeprefix("Value error, ")
+        rule = plain_rule(error.errors()[0])
         raise InvalidParameterError(
             f"{rule}: give the route its product, or the candidate's box its goods", "product"
         ) from None
