@@ -12,10 +12,12 @@ the line of the file (its header is line 1).
 
 Or GPS traces — one row per fix: ``route_id``, ``date``, ``time`` (local HH:MM[:SS]), ``lat``,
 ``lon`` — each day's fixes together and in time order. The day starts when the van leaves the
-depot (its last fix within :data:`AT_DEPOT_M`), ends when it is back, and a stop is where it
-stays within :data:`DWELL_RADIUS_M` for :data:`MIN_DWELL_S` or longer (the dwell detection
-of telematics "stop" reports, e.g. Geotab's trips and stops): its place the mean of those
-fixes, its service the dwell.
+depot (its last fix within :data:`AT_DEPOT_M`), ends when it is back for the last time (a van
+passing its depot drives on; one back between two tours dwells there: a stop at the depot),
+and a stop is where it stays within :data:`DWELL_RADIUS_M` for :data:`MIN_DWELL_S` or longer
+(the dwell detection of telematics "stop" reports, e.g. Geotab's trips and stops): its place
+the mean of those fixes, its service the dwell. In the stop rows too, a row at the depot
+before the day's last is a visit there (a second tour), with its arrival and departure.
 """
 
 from __future__ import annotations
@@ -122,7 +124,7 @@ def _lines(text: str) -> tuple[list[_Line], bool]:
 
 
 class _Day:
-    """A route's day being read: its start and stops, the time reached, whether it is back."""
+    """A route's day being read: its start, its stops and the time reached."""
 
     def __init__(self, first: _Line, depot_id: str) -> None:
         if first.text("stop_id") != depot_id:
@@ -132,24 +134,32 @@ class _Day:
         self.date = first.date()
         self.start_s = self.clock_s = first.seconds("departure")
         self.stops: list[dict[str, Any]] = []
-        self.back = False
         self.depot_id = depot_id
 
-    def add(self, row: _Line) -> None:
-        if self.back:
-            raise row.error("stop_id", "a row after the return to the depot the same day")
+    def add(self, row: _Line, last: bool) -> None:
+        """The next row; ``last``: the day's last, where the depot is the return (before it,
+        a visit to the depot — a second tour after lunch — is a stop there, so the day's
+        kilometres and hours are all counted)."""
         arrival = row.seconds("arrival")
         if arrival < self.clock_s:
             raise row.error(
                 "arrival", f"arrival {row.text('arrival')} is before {_clock(self.clock_s)}"
             )
-        if row.text("stop_id") == self.depot_id:
-            self.back, self.clock_s = True, arrival
-            return
+        stop_id = row.text("stop_id")
+        if stop_id == self.depot_id:
+            if last:
+                self.clock_s = arrival
+                return
+            if not row.text("departure"):
+                raise row.error(
+                    "departure",
+                    "a return to the depot before the day's last row needs its departure "
+                    "(the van sets off again)",
+                )
+            stop_id = f"{self.depot_id} ({row.text('arrival')})"
         departure = row.seconds("departure")
         if departure < arrival:
             raise row.error("departure", f"departure {row.text('departure')} is before arrival")
-        stop_id = row.text("stop_id")
         if not stop_id or any(stop["id"] == stop_id for stop in self.stops):
             raise row.error("stop_id", f"stop {stop_id!r} is empty or twice in the day")
         service_s = float(departure - arrival)
@@ -246,8 +256,8 @@ def _days(lines: list[_Line], by_id: dict[str, int]) -> list[tuple[str, list[_Li
 def _visited(group: list[_Line], depot: dict[str, Any]) -> dict[str, Any]:
     """A day of one row per stop visited."""
     day = _Day(group[0], str(depot.get("id")))
-    for row in group[1:]:
-        day.add(row)
+    for k, row in enumerate(group[1:], start=2):
+        day.add(row, last=k == len(group))
     return day.driven(group[-1])
 
 
@@ -266,9 +276,9 @@ def _traced(route_id: str, group: list[_Line], depot: dict[str, Any]) -> dict[st
     away = np.flatnonzero(from_depot_m > AT_DEPOT_M)
     if from_depot_m[0] > AT_DEPOT_M or away.size == 0:
         raise group[0].error("lat", "a day's trace begins at the depot, then leaves it")
-    leave = int(away[0])
-    back = leave + int(np.argmax(from_depot_m[leave:] <= AT_DEPOT_M))
-    end = back if from_depot_m[back] <= AT_DEPOT_M else len(group)
+    # from the first fix away to the last return: a van that passes its depot, or comes back
+    # between two tours, drives on (a stop there where it dwelt)
+    leave, end = int(away[0]), int(away[-1]) + 1
     stops = _dwells(route_id, group[0].date(), times[leave:end], lat[leave:end], lon[leave:end])
     if not stops:
         raise group[0].error(

@@ -72,7 +72,11 @@ def test_an_export_becomes_the_routes_days_and_the_study_runs_on_them():
         ([ROWS[0], ROWS[1].replace("2026-07-14", "14.7.2026")], "history[3].date", "not a date"),
         ([*ROWS[4:6], *ROWS[0:2]], "history[4].date", "after a later day"),
         ([*ROWS[0:2], *ROWS[6:8], ROWS[1]], "history[6].date", "not together"),
-        ([*ROWS[0:4], ROWS[1].replace("billa", "penny")], "history[6].stop_id", "after the return"),
+        (
+            [*ROWS[0:4], ROWS[1].replace("billa", "penny")],
+            "history[5].departure",
+            "needs its departure",
+        ),
         (
             [ROWS[0], ROWS[1], ROWS[1].replace("07:20", "07:40").replace("07:29", "07:45")],
             "history[4].stop_id",
@@ -203,3 +207,52 @@ def test_traces_need_their_depot_and_their_columns():
     assert response.json()["errors"][0]["field"] == "routes[0].depot"
     missing = send(TRACE, header="route_id,date,time,lat")
     assert missing.status_code == 422 and "GPS traces" in missing.json()["detail"]
+
+
+def test_a_second_tour_after_lunch_is_one_day_with_a_stop_at_the_depot():
+    # an audit's export: back at the depot for lunch, out again; the GPS reader lost the
+    # afternoon (a 200 with half the day), the stop rows refused it
+    lunch = "tour-1,2026-07-14,depot,48.17,16.42,08:10,12:30,,"
+    afternoon = [
+        "tour-1,2026-07-14,hofer,48.2036,16.3489,12:55,13:02,35,3.5",
+        "tour-1,2026-07-14,depot,48.17,16.42,13:30,,,",
+    ]
+    rows = [*ROWS[0:3], lunch, *afternoon, *ROWS[6:8]]
+    response = send(rows)
+    assert response.status_code == 200, response.text
+    day = response.json()["routes"][0]["days"][0]
+    assert [stop["id"] for stop in day["stops"]] == ["billa", "spar", "depot (08:10)", "hofer"]
+    assert day["stops"][2]["service_time_s"] == 4 * 3600 + 20 * 60
+
+
+def _trace(fixes) -> list[str]:
+    return [f"tour-1,2026-07-14,{_clock(t)},{lat:.6f},{lon:.6f}" for t, lat, lon in fixes]
+
+
+EAST = (48.17, 16.4400)  # 1.5 km east of the depot: the way to it passes the depot
+
+
+def test_a_trace_that_passes_its_depot_or_comes_back_for_lunch_keeps_the_whole_day():
+    passing = [
+        *FIXES[: FIXES.index(next(f for f in FIXES if f[0] >= _h(8, 10)))],  # to the depot…
+        *_drive(DEPOT_AT, EAST, _h(8, 10), _h(8, 20)),  # … through it, not stopping
+        *_stay(EAST, _h(8, 20), _h(8, 30)),
+        *_drive(EAST, DEPOT_AT, _h(8, 30), _h(8, 40)),
+        *_stay(DEPOT_AT, _h(8, 40), _h(9, 0)),
+    ]
+    lunch = [
+        *FIXES,  # back 08:10, parked until 08:30
+        *_drive(DEPOT_AT, EAST, _h(8, 30), _h(8, 40)),
+        *_stay(EAST, _h(8, 40), _h(8, 50)),
+        *_drive(EAST, DEPOT_AT, _h(8, 50), _h(9, 0)),
+        *_stay(DEPOT_AT, _h(9, 0), _h(9, 20)),
+    ]
+    one = {**STUDY, "routes": STUDY["routes"][:1]}
+    for fixes, at_depot in ((passing, 0), (lunch, 1)):
+        response = send(_trace(fixes), study=one, header=TRACE_HEADER)
+        assert response.status_code == 200, response.text
+        stops = response.json()["routes"][0]["days"][0]["stops"]
+        places = [(round(s["lat"], 3), round(s["lon"], 3)) for s in stops]
+        depot = (round(DEPOT_AT[0], 3), round(DEPOT_AT[1], 3))
+        assert places.count(depot) == at_depot and places[-1] == (48.17, 16.44), places
+        assert len(stops) == 3 + at_depot  # Billa, Spar, east (and the depot at lunch)
