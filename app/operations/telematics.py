@@ -31,6 +31,7 @@ import numpy as np
 from pydantic import ValidationError
 
 from app.operations.cells import delimiter_of, header_of, number
+from core.clock import departure
 from core.exceptions import InvalidParameterError
 from core.params import Location
 from core.routing.geo import metres_from
@@ -46,6 +47,9 @@ DWELL_RADIUS_M = 50.0
 #: … for at least this long [s].
 MIN_DWELL_S = 120.0
 _CLOCK = re.compile(r"([01][0-9]|2[0-3]):([0-5][0-9])(?::([0-5][0-9]))?")
+_DATE = re.compile(r"[0-9]{4}-[0-9]{2}-[0-9]{2}")
+#: The longest stop id a study takes (as ``Stop.id``).
+MAX_ID = 64
 #: Door minutes when the export has none: a minute, or the whole service when shorter [s].
 DEFAULT_DOOR_S = 60.0
 
@@ -80,12 +84,25 @@ class _Line:
         return hours * 3600 + minutes * 60 + seconds
 
     def date(self) -> dt.date:
+        """The row's date, YYYY-MM-DD only (Python would read 20260302 and 2026-W10-1 too)."""
         try:
+            if not _DATE.fullmatch(self.text("date")):
+                raise ValueError
             return dt.date.fromisoformat(self.text("date"))
         except ValueError:
             raise self.error(
                 "date", f"{self.text('date')[:20]!r} is not a date YYYY-MM-DD"
             ) from None
+
+    def starting(self, column: str, timezone: str | None, lon: float) -> None:
+        """The day's start at this row's ``column`` is a moment of its zone: not skipped by
+        the clocks (the spring change), as the study would find later."""
+        start = dt.time.fromisoformat(_clock(self.seconds(column))[:5])
+        try:
+            departure(self.date(), start, timezone, lon)
+        except InvalidParameterError as error:
+            if error.field == "start_time":  # else the study's own field (its zone) is wrong
+                raise self.error(column, error.message) from None
 
 
 def _clock(seconds: int) -> str:
@@ -161,14 +178,18 @@ class _Day:
         if departure < arrival:
             raise row.error("departure", f"departure {row.text('departure')} is before arrival")
         if not stop_id or any(stop["id"] == stop_id for stop in self.stops):
-            raise row.error("stop_id", f"stop {stop_id!r} is empty or twice in the day")
+            raise row.error("stop_id", f"stop {stop_id[:MAX_ID]!r} is empty or twice in the day")
+        if len(stop_id) > MAX_ID:
+            raise row.error(
+                "stop_id", f"a stop id is at most {MAX_ID} characters, not {len(stop_id):,}"
+            )
         service_s = float(departure - arrival)
         door_s = min(DEFAULT_DOOR_S, service_s)
         if row.text("door_minutes"):
             door_s = row.number("door_minutes", 0, service_s / 60.0) * 60.0
         self.stops.append(
             {
-                "id": stop_id[:64],
+                "id": stop_id,
                 "lat": row.number("lat", -90, 90),
                 "lon": row.number("lon", -180, 180),
                 "service_time_s": service_s,
@@ -209,8 +230,10 @@ def with_history(body: dict[str, Any], text: str) -> dict[str, Any]:
                 )
         by_id[route["id"]] = k
     lines, traces = _lines(text)
+    year = body.get("year") if isinstance(body.get("year"), int) else None
+    timezone = body.get("timezone") if isinstance(body.get("timezone"), str) else None
     days: list[list[dict[str, Any]]] = [[] for _ in routes]
-    for route_id, group in _days(lines, by_id):
+    for route_id, group in _days(lines, by_id, year):
         depot = routes[by_id[route_id]]["depot"]
         if traces:
             try:
@@ -220,7 +243,11 @@ def with_history(body: dict[str, Any], text: str) -> dict[str, Any]:
                     "a depot needs its lat (-90..90) and lon (-180..180) to find it in the traces",
                     f"routes[{by_id[route_id]}].depot",
                 ) from None
-        day = _traced(route_id, group, depot) if traces else _visited(group, depot)
+        day = (
+            _traced(route_id, group, depot, timezone)
+            if traces
+            else _visited(group, depot, timezone)
+        )
         days[by_id[route_id]].append(day)
     for k, route_days in enumerate(days):
         if not route_days:
@@ -228,9 +255,11 @@ def with_history(body: dict[str, Any], text: str) -> dict[str, Any]:
     return body | {"routes": [r | {"days": d} for r, d in zip(routes, days, strict=True)]}
 
 
-def _days(lines: list[_Line], by_id: dict[str, int]) -> list[tuple[str, list[_Line]]]:
+def _days(
+    lines: list[_Line], by_id: dict[str, int], year: int | None
+) -> list[tuple[str, list[_Line]]]:
     """The rows of each route's day, in the file's order: a day's rows together, a route's
-    days in date order."""
+    days in date order, every date in the study's ``year``."""
     out: list[tuple[str, list[_Line]]] = []
     seen: set[tuple[str, dt.date]] = set()
     last: dict[str, dt.date] = {}
@@ -240,6 +269,8 @@ def _days(lines: list[_Line], by_id: dict[str, int]) -> list[tuple[str, list[_Li
         if route_id not in by_id:
             raise row.error("route_id", f"no route of the study has the id {route_id[:64]!r}")
         here = (route_id, row.date())
+        if year is not None and here[1].year != year:
+            raise row.error("date", f"{here[1]} is not in the study's year {year}")
         if here == key:
             out[-1][1].append(row)
             continue
@@ -253,16 +284,26 @@ def _days(lines: list[_Line], by_id: dict[str, int]) -> list[tuple[str, list[_Li
     return out
 
 
-def _visited(group: list[_Line], depot: dict[str, Any]) -> dict[str, Any]:
-    """A day of one row per stop visited."""
+def _visited(group: list[_Line], depot: dict[str, Any], timezone: str | None) -> dict[str, Any]:
+    """A day of one row per stop visited, starting at a moment of ``timezone``."""
     day = _Day(group[0], str(depot.get("id")))
+    group[0].starting("departure", timezone, _lon(depot))
     for k, row in enumerate(group[1:], start=2):
         day.add(row, last=k == len(group))
     return day.driven(group[-1])
 
 
-def _traced(route_id: str, group: list[_Line], depot: dict[str, Any]) -> dict[str, Any]:
-    """A day of GPS fixes: its departure from the depot and its stops (dwells)."""
+def _lon(depot: dict[str, Any]) -> float:
+    """The depot's longitude where it has one (the clock of a study without a zone)."""
+    lon = depot.get("lon")
+    return float(lon) if isinstance(lon, int | float) and -180 <= lon <= 180 else 0.0
+
+
+def _traced(
+    route_id: str, group: list[_Line], depot: dict[str, Any], timezone: str | None
+) -> dict[str, Any]:
+    """A day of GPS fixes: its departure from the depot (a moment of ``timezone``) and its
+    stops (dwells)."""
     times = np.array([row.seconds("time") for row in group], dtype=float)
     for k in range(1, len(group)):
         if times[k] <= times[k - 1]:
@@ -279,6 +320,7 @@ def _traced(route_id: str, group: list[_Line], depot: dict[str, Any]) -> dict[st
     # from the first fix away to the last return: a van that passes its depot, or comes back
     # between two tours, drives on (a stop there where it dwelt)
     leave, end = int(away[0]), int(away[-1]) + 1
+    group[leave - 1].starting("time", timezone, _lon(depot))
     stops = _dwells(route_id, group[0].date(), times[leave:end], lat[leave:end], lon[leave:end])
     if not stops:
         raise group[0].error(

@@ -70,6 +70,17 @@ def test_an_export_becomes_the_routes_days_and_the_study_runs_on_them():
         ([ROWS[0], ROWS[1].replace(",4", ",20")], "history[3].door_minutes", "within 0..9"),
         ([ROWS[0], ROWS[1].replace("tour-1", "tour-9")], "history[3].route_id", "no route"),
         ([ROWS[0], ROWS[1].replace("2026-07-14", "14.7.2026")], "history[3].date", "not a date"),
+        # an audit's: what Python reads as dates, a date of another year, an id cut at 64,
+        # a start the clocks skip — each accepted here and refused by the study later
+        ([r.replace("2026-07-14", "20260714") for r in ROWS[:4]], "history[2].date", "not a"),
+        ([r.replace("2026-07-14", "2026-W29-2") for r in ROWS[:4]], "history[2].date", "not a"),
+        ([r.replace("2026-07-14", "2025-07-14") for r in ROWS[:4]], "history[2].date", "year"),
+        ([ROWS[0], ROWS[1].replace("billa", "b" * 65)], "history[3].stop_id", "at most 64"),
+        (
+            [r.replace("2026-07-14", "2026-03-29").replace("07:00", "02:30") for r in ROWS[:4]],
+            "history[2].departure",
+            "the clocks skip it",
+        ),
         ([*ROWS[4:6], *ROWS[0:2]], "history[4].date", "after a later day"),
         ([*ROWS[0:2], *ROWS[6:8], ROWS[1]], "history[6].date", "not together"),
         (
