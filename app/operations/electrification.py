@@ -45,12 +45,16 @@ def electrification_problem(
     synchronous answer's: a 413 pointing to jobs); a candidate's own errors name it."""
     candidates = []
     for index, candidate in enumerate(request.candidates):
+        # a strategy (the candidate's own, or the study's) is set on the van as it is, for
+        # the goods come from each route: the van is checked whole with them (carrying)
+        own = "refrigeration" in candidate.model_fields_set
+        strategy = candidate.refrigeration if own else request.refrigeration
         try:
-            van = van_of(candidate, settings)
+            van = van_of(candidate.model_copy(update={"refrigeration": None}), settings)
         except CoreError as error:
             raise error.under(f"candidates[{index}]") from None
-        if request.refrigeration is not None and "refrigeration" not in candidate.model_fields_set:
-            van = van.model_copy(update={"refrigeration": request.refrigeration})
+        if strategy is not None:
+            van = van.model_copy(update={"refrigeration": strategy})
         candidates.append(Candidate(id=candidate.id, van=van))
     problem = ElectrificationProblem(
         **fields_of(request, StudyFields),

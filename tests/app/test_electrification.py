@@ -176,6 +176,29 @@ def test_the_studys_strategy_runs_with_each_routes_goods():
         assert all(c["cold_chain_days_broken"] == 0 for c in route["candidates"])
 
 
+def test_a_candidates_own_strategy_runs_with_each_routes_goods():
+    """ "This van with a thermostat against optimal", done as documented: each candidate its
+    own strategy, the goods from the routes (an audit's: a 422 "needs cargo_box.product" for
+    the candidate's own, where the study's was accepted)."""
+    body = _with(
+        lambda b: (
+            [c.pop("cargo_box") for c in b["candidates"]],
+            b["candidates"].append(
+                b["candidates"][0] | {"id": "optimal", "refrigeration": {"strategy": "optimal"}}
+            ),
+            [r.update(product="chilled-dairy", days=["2026-07-15"]) for r in b["routes"]],
+        )
+    )
+    response = app_client().post(PATH, json=body)
+    assert response.status_code == 200, response.text
+    for route in response.json()["routes"]:
+        thermostat, optimal = route["candidates"][0], route["candidates"][-1]
+        assert optimal["id"] == "optimal"
+        assert optimal["cold_chain_days_broken"] == 0
+        unit = "refrigeration"
+        assert optimal["energy_kwh_mean"][unit] < thermostat["energy_kwh_mean"][unit]
+
+
 def _archived(body: dict) -> dict:
     """The example in 2025 (archived: a year gone), on its first days, from the archive."""
     return body | {
