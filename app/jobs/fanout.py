@@ -120,11 +120,17 @@ class PartedRun:
         take is redone (the part's heartbeat stops)."""
         held: Held = {}
         self._last_sweep = time.monotonic()
+        # when the database was last found back (at start: long enough for a sweep)
+        self._reachable_since: float | None = self._last_sweep - self.settings.job_stale_after_s
         while True:
             try:
                 ending = self._step(job, context, deadline, held, coordinating)
             except OperationalError as error:
-                _log.warning("job %s: the database is away (%s); the parts go on", job.id, error)
+                if self._reachable_since is not None:  # said once an outage
+                    _log.warning(
+                        "job %s: the database is away (%s); the parts go on", job.id, error
+                    )
+                self._reachable_since = None
                 time.sleep(self.settings.job_heartbeat_s)
                 continue
             if ending is not None:
@@ -153,8 +159,10 @@ class PartedRun:
             time.sleep(self.settings.job_heartbeat_s)
         for index, (part, future) in list(held.items()):
             if future.done():
-                del held[index]
+                # held until its ending is recorded: a database away meanwhile keeps the
+                # result for the next step (it was dropped and the part redone, an attempt)
                 ending = self._ended(job, part, future, held, coordinating)
+                held.pop(index, None)
                 if ending is not None:
                     return ending
         if not coordinating:
@@ -162,7 +170,13 @@ class PartedRun:
         ending = self._beat_job(job, deadline, held)
         if ending is not None:
             return ending
-        if time.monotonic() - self._last_sweep >= SWEEP_EVERY_S:
+        if self._reachable_since is None:
+            self._reachable_since = time.monotonic()
+        reachable_s = time.monotonic() - self._reachable_since
+        # parts judged lost only once every runner had the time to beat again after an outage
+        if time.monotonic() - self._last_sweep >= SWEEP_EVERY_S and (
+            reachable_s >= self.settings.job_stale_after_s
+        ):
             self._last_sweep = time.monotonic()
             if not self._redo_lost(job):
                 return self._stop(job, held, "failed")

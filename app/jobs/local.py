@@ -8,6 +8,8 @@ import asyncio
 import contextlib
 import logging
 
+from sqlalchemy.exc import OperationalError
+
 from app.execution import Executor
 from app.jobs.fanout import PartedRun
 from app.jobs.lifecycle import SWEEP_EVERY_S, Lifecycle, runner_name
@@ -48,6 +50,7 @@ class LocalRunner:
 
     async def _loop(self) -> None:
         last_sweep = 0.0
+        away = False  # the database, as last seen: said once when it goes, once when it is back
         loop = asyncio.get_running_loop()
         while True:
             self._queued.clear()  # before looking: a job queued while we look is seen next
@@ -58,8 +61,16 @@ class LocalRunner:
                 while len(self.watching) < self.settings.job_concurrency:
                     if not await self._take():
                         break
-            except Exception:  # the database may be briefly away: keep going
+            except OperationalError as error:  # the database is away: one line, no trace
+                if not away:
+                    _log.warning("job runner: the database is away (%s); waiting for it", error)
+                away = True
+            except Exception:
                 _log.exception("job runner: housekeeping failed; retrying")
+            else:
+                if away:
+                    _log.warning("job runner: the database is back")
+                away = False
             with contextlib.suppress(TimeoutError):
                 await asyncio.wait_for(self._queued.wait(), LOOK_EVERY_S)
 

@@ -16,6 +16,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import httpx
+import psycopg
 import pytest
 import redis
 
@@ -24,10 +25,17 @@ from app.jobs.celery_app import celery_for, visibility_timeout_s
 from app.jobs.lifecycle import JOB_EXTRA_TIME_S
 from app.jobs.store import JobStore
 from app.settings import Settings
-from benchmarks.common import Server, children
+from benchmarks.common import POSTGRES, Server, children
 from tests.app.serving import alive, long_plan
 from tests.app.test_celery import Worker, own_services
-from tests.app.test_jobs import FAST, submit, wait_for
+from tests.app.test_jobs import (
+    BIG_STUDY,
+    FAST,
+    running_with_parts_done,
+    submit,
+    wait_for,
+    without_clock,
+)
 from tests.utils.tcp_proxy import TcpProxy
 
 #: How long PostgreSQL is away in the outage test [s]: longer than Celery's default retries.
@@ -420,3 +428,51 @@ def test_a_celery_workers_process_killed_while_idle_is_replaced(broker, services
     finally:
         worker.stop()
         server.close()
+
+
+def test_a_database_outage_mid_study_redoes_no_part_on_the_local_pool():
+    """The fault audit: parts that finished while PostgreSQL was away left the held list
+    before their result was stored — each redone, an attempt counted (the guide says an
+    absent database costs none) — and the runner logged a traceback every 0.5 s. The server's
+    own pool runs a study in parts; the database is cut off for 6 s while parts run: every
+    part done once, the answer the endpoint's."""
+    proxy = TcpProxy(("127.0.0.1", 5432))
+    try:
+        with own_services() as env:
+            schema = env["COLDROUTE_DATABASE_URL"].rsplit("search_path%3D", 1)[1]
+            env = {
+                "COLDROUTE_DATABASE_URL": env["COLDROUTE_DATABASE_URL"].replace(
+                    "127.0.0.1:5432", f"127.0.0.1:{proxy.port}"
+                ),
+                "COLDROUTE_WORKERS": "2",
+                "COLDROUTE_JOB_PART_ROUTE_DAYS": "100",  # a part per route
+                "COLDROUTE_MAX_SYNC_ROUTE_DAYS": "100000",
+            }
+            server = Server(env).start()
+            try:
+                study = {"type": "electrification", "request": BIG_STUDY}
+                job_id = submit(server.url, study).json()["id"]
+                running_with_parts_done(server.url, job_id, timeout_s=120)
+                proxy.cut()
+                time.sleep(6)
+                proxy.mend()
+                done = wait_for(server.url, job_id, timeout=300)
+                local = httpx.post(
+                    f"{server.url}/v1/studies/electrification", json=BIG_STUDY, timeout=300
+                )
+                log = server.log_path.read_text()
+            finally:
+                server.close()
+            with psycopg.connect(POSTGRES, options=f"-csearch_path={schema}") as connection:
+                attempts = [
+                    row[0]
+                    for row in connection.execute(
+                        "SELECT attempts FROM job_parts WHERE job_id = %s", (job_id,)
+                    )
+                ]
+    finally:
+        proxy.close()
+    assert done["status"] == "succeeded" and done["attempts"] == 1, done
+    assert attempts and set(attempts) == {1}, attempts
+    assert without_clock(done["result"]) == without_clock(local.json())
+    assert log.count("Traceback") == 0, log[-3000:]
