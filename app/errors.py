@@ -126,7 +126,8 @@ def _location(loc: tuple[Any, ...], kind: str = "", body: Any = None) -> str:
         return "body"
     in_body = bool(loc) and loc[0] == "body"
     parts = list(loc[1:] if in_body else loc)
-    path, value, known = "", body, in_body and body is not None
+    # a JSON body is read against; a form's parts (multipart, urlencoded) are named as sent
+    path, value, known = "", body, in_body and isinstance(body, dict | list)
     for index, part in enumerate(parts):
         if isinstance(part, str) and part.startswith(BRANCH_TAG):  # a tagged union's branch
             continue
@@ -156,7 +157,13 @@ def _union_branch(part: str) -> bool:
     return "[" in part or part[:1].isupper() or part in _PLAIN_TYPES
 
 
+#: FastAPI's word for a form field where a file was expected.
+_NOT_A_FILE = "Expected UploadFile"
+
+
 def _message(error: Any) -> str:
+    if plain_rule(error).startswith(_NOT_A_FILE):
+        return "must be a file (multipart/form-data, a part with a filename), not a text field"
     if error["type"] == "json_invalid":
         position = error["loc"][-1] if error["loc"] else "?"
         reason = (error.get("ctx") or {}).get("error", "invalid JSON")

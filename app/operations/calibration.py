@@ -168,9 +168,10 @@ def with_csv_trips(body: dict[str, Any], files: dict[str, str]) -> dict[str, Any
             )
         k = by_id[trip_id]
         given = [name for name in CSV_COLUMNS if name in merged[k]]
-        if given:
+        if given:  # the samples come from the file: none in the JSON, whatever the file holds
             raise InvalidParameterError(
-                f"trip {trip_id!r} has {given[0]} both in the JSON and in its file",
+                f"trip {trip_id!r} has {given[0]} in the JSON: its samples come from its file "
+                f"{filename[:60]!r}; leave the sample columns out of the JSON",
                 f"trips[{k}].{given[0]}",
             )
         merged[k] |= csv_columns(text, f"trips[{k}]")

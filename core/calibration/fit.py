@@ -246,7 +246,8 @@ def calibrate(
     unmeasured = _unmeasured(chosen, fitted)
     result = _uncertainty(chosen, solution, fitted, unmeasured)
     warnings = (
-        _warnings(result.correlation, chosen, fitted)
+        result.warnings
+        + _warnings(result.correlation, chosen, fitted)
         + _temperature_warnings(fitted, unmeasured)
         + _stretched(best, resampled)
     )
@@ -552,6 +553,7 @@ def _solve(
 class _Uncertainty:
     parameters: list[FittedParameter]
     correlation: FloatArray
+    warnings: list[str] = field(default_factory=list)
 
 
 #: The HAC estimator's bandwidth as a share of each measured series (fixed-b, Kiefer &
@@ -620,8 +622,9 @@ def _uncertainty(
     correlation = np.nan_to_num(correlation, nan=1.0)
     quantile = fixed_b_quantile(HAC_BANDWIDTH_SHARE)
     seen = np.abs(jac).sum(axis=0) > 0
-    singular = np.linalg.matrix_rank(jac) < p
-    fitted = []
+    # among the parameters the trips see (one they do not leaves the others their intervals)
+    singular = np.linalg.matrix_rank(jac[:, seen]) < int(seen.sum())
+    fitted, warnings = [], []
     for k, parameter in enumerate(chosen):
         value = float(solution.x[k]) * parameter.scale
         error = float(std[k]) * parameter.scale
@@ -646,7 +649,18 @@ def _uncertainty(
                 identifiable=identifiable,
             )
         )
-    return _Uncertainty(fitted, correlation)
+        if not seen[k]:  # why no interval, said (unmeasured ones have their own warning)
+            warnings.append(
+                f"'{parameter.name}' changes nothing the trips measured (no measured power "
+                "includes what it drives: the refrigeration's for cop, say): it stays at "
+                f"{value:g}, no interval given; measure that power to fit it"
+            )
+        elif singular and parameter.name not in unmeasured:
+            warnings.append(
+                f"'{parameter.name}': the trips cannot fix every chosen parameter at once (the "
+                "fit's Jacobian is singular): no interval given; fit fewer parameters"
+            )
+    return _Uncertainty(fitted, correlation, warnings)
 
 
 #: The consumers whose draw follows the outside temperature (the cab's HVAC, the box's

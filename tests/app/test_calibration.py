@@ -219,6 +219,9 @@ def test_a_bad_csv_is_a_422_naming_trip_column_and_row(client, edit, field, word
     assert any(e["field"] == field and words in e["message"] for e in errors), errors
 
 
+FORM = "application/x-www-form-urlencoded"
+
+
 def test_files_and_trips_must_match(client):
     data, files = as_csv(CALIBRATION_EXAMPLE)
     missing = client.post("/v1/calibrations/csv", data=data, files=files[:1])
@@ -234,6 +237,17 @@ def test_files_and_trips_must_match(client):
     both["trips"][1]["time_s"] = CALIBRATION_EXAMPLE["trips"][1]["time_s"]
     twice = client.post("/v1/calibrations/csv", data={"calibration": json.dumps(both)}, files=files)
     assert twice.json()["errors"][0]["field"] == "trips[1].time_s"
+    # not "both in the JSON and in its file" when the file has no such column (an audit's)
+    assert "both" not in twice.json()["detail"] and "come from its file" in twice.json()["detail"]
+    # trips as a text field, or the form urlencoded: named, in the request's words
+    for sent in (
+        {"data": data | {"trips": "city.csv"}},
+        {"content": "calibration=%7B%7D&trips=x", "headers": {"content-type": FORM}},
+    ):
+        refused = client.post("/v1/calibrations/csv", **sent)  # type: ignore[arg-type]
+        assert refused.status_code == 422
+        assert refused.json()["errors"][0]["field"] == "trips[0]", refused.json()
+        assert "must be a file" in refused.json()["detail"]
     broken = client.post("/v1/calibrations/csv", data={"calibration": "{"}, files=files)
     assert broken.status_code == 422 and broken.json()["errors"][0]["field"] == "calibration"
     meta = json.loads(data["calibration"])

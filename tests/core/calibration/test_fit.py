@@ -350,3 +350,34 @@ def test_without_the_outside_temperature_the_auxiliaries_get_no_interval():
     # with the thermometer's log the same trips give every interval
     logged = [measured_trip(truth, n, k, rng, 100.0) for k, n in enumerate(names)]
     assert all(p.ci95 is not None for p in calibrate(truth, logged, []).parameters)
+
+
+def test_a_parameter_no_measured_power_depends_on_gets_no_interval_and_a_warning():
+    """An audit's: the COP fitted on trips that measured the traction alone came back with a
+    null interval and nothing saying why."""
+    truth = PRESETS["ev-van-3.5t-reefer"].van()
+    rng = np.random.default_rng(5)
+    trips = []
+    for k, name in enumerate(["udds", "hwfet"]):
+        drive = cycle(name)
+        n = drive.speed_mps.size
+        result = simulate(drive.speed_mps, drive.dt_s, START, VIENNA, truth)
+        traction_w = np.sum([result.power_w[c] for c in CHANNELS["traction_power_w"]], axis=0)
+        trips.append(
+            MeasuredTrip(
+                id=f"{name}-{k}",
+                start=START,
+                location=VIENNA,
+                time_s=np.arange(n) * drive.dt_s,
+                speed_mps=drive.speed_mps,
+                measured_w={"traction_power_w": as_logged(traction_w, n) + rng.normal(0, 50, n)},
+                ambient_c=np.full(n, 20.0),
+            )
+        )
+    parameters = [FitParameter(name="drag_coefficient"), FitParameter(name="cop")]
+    fit = calibrate(truth, trips, parameters)
+    cop = next(p for p in fit.parameters if p.name == "cop")
+    assert cop.ci95 is None and not cop.identifiable
+    assert any("'cop' changes nothing the trips measured" in w for w in fit.warnings), fit.warnings
+    drag = next(p for p in fit.parameters if p.name == "drag_coefficient")
+    assert drag.ci95 is not None
