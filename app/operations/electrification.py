@@ -30,7 +30,7 @@ from core.planning.electrification.study import (
     merged,
     parts_of,
     route_dates,
-    route_days,
+    simulated_days,
     study_part,
     year_weather,
 )
@@ -61,8 +61,8 @@ def electrification_problem(
         candidates=candidates,
         weather_source=request.weather.source,
     )
-    simulated = route_days(problem) * len(candidates)
-    said = f"{simulated:,} route-days × candidates"
+    simulated = simulated_days(problem) * len(candidates)
+    said = f"{simulated:,} route-days × candidates (a round counted once for each day it lasts)"
     if simulated > settings.max_route_days:
         raise ServerLimitError(
             f"{said}; this server simulates at most {settings.max_route_days:,} per study "
@@ -146,7 +146,7 @@ def run_study(request: ElectrificationRequest, settings: Settings) -> Electrific
 def time_limit_s(request: ElectrificationRequest) -> float:
     """The longest a study as a job may run beyond its fixed allowance [s]: its
     simulations at the slowest pace a worker keeps (the optimal refrigeration strategy)."""
-    return route_days(request) * len(request.candidates) / SLOWEST_ROUTE_DAYS_PER_S
+    return simulated_days(request) * len(request.candidates) / SLOWEST_ROUTE_DAYS_PER_S
 
 
 def weather_json(weather: Weather) -> dict[str, Any]:

@@ -89,6 +89,31 @@ def test_more_route_days_than_the_server_takes_is_a_413_naming_the_limit():
     assert sync.status_code == 413 and "type electrification" in sync.json()["detail"]
 
 
+def test_a_round_of_several_days_counts_once_for_each_day_it_lasts():
+    """An audit's: 1,200 cells of a 5.8-day round were taken like 1,200 of an hour's. One
+    route on 20 dates, one candidate: 20 route-days of an hour; of six days, 120 — above a
+    limit of 100 (its stops' service alone lasts 5.8 days)."""
+    limited = app_client(max_route_days=100)
+
+    def study(service_s: float) -> dict:
+        return _with(
+            lambda b: (
+                b.update(candidates=b["candidates"][:1], routes=b["routes"][:1]),
+                b["routes"][0].update(
+                    days=[f"2026-07-{d:02d}" for d in range(1, 21)],
+                    stops=[s | {"service_time_s": service_s} for s in b["routes"][0]["stops"]],
+                ),
+            )
+        )
+
+    stops = len(ELECTRIFICATION_EXAMPLE["routes"][0]["stops"])
+    short = limited.post(PATH, json=study(600.0))
+    assert short.status_code == 200, short.text
+    long = limited.post(PATH, json=study(5.8 * 86_400 / stops))
+    assert long.status_code == 413, long.text
+    assert "120 route-days × candidates" in long.json()["detail"]
+
+
 def _with(change) -> dict:
     body = copy.deepcopy(ELECTRIFICATION_EXAMPLE)
     change(body)

@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
+import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+import numpy as np
 from pydantic import ValidationError
 
 from core.clock import departure
@@ -51,6 +53,7 @@ from core.planning.itinerary import Itinerary
 from core.planning.model import PlanProblem
 from core.planning.round.planner import check
 from core.planning.search.day import leg_roads
+from core.routing.geo import great_circle_m
 from core.routing.roads import RoadRouter
 
 #: A day as driven: its departure and its stops.
@@ -95,6 +98,27 @@ def route_days(problem: StudyFields) -> int:
     return sum(
         len(route_dates(r, problem.year, f"routes[{i}].days")) for i, r in enumerate(problem.routes)
     )
+
+
+#: The speed a round's size is judged at before it is simulated [m/s] (50 km/h, as the
+#: crow flies: a city's roads are longer and slower, so the judgement errs small).
+SIZING_SPEED_MPS = 50 / 3.6
+
+
+def simulated_days(problem: StudyFields) -> int:
+    """What the study simulates, in days: each route-day counted once for every day (or part
+    of one) it lasts — its stops' service and its legs as the crow flies at
+    :data:`SIZING_SPEED_MPS` — so that a limit on it weighs a round of six
+    days six times, not as one of an hour."""
+    total = 0
+    for i, route in enumerate(problem.routes):
+        for _, stops in driven(route, problem.year, f"routes[{i}].days").values():
+            lat = np.array([route.depot.lat, *(s.lat for s in stops), route.depot.lat])
+            lon = np.array([route.depot.lon, *(s.lon for s in stops), route.depot.lon])
+            legs_m = float(np.sum(np.diag(great_circle_m(lat, lon), 1)))
+            span_s = legs_m / SIZING_SPEED_MPS + sum(stop.service_time_s for stop in stops)
+            total += max(math.ceil(span_s / 86_400.0), 1)
+    return total
 
 
 def check_study(problem: ElectrificationProblem) -> None:
