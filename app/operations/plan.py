@@ -6,7 +6,7 @@ from dataclasses import replace
 from typing import Any
 
 from app import connectors
-from app.operations.answers import attribution, battery, box, energy, weather
+from app.operations.answers import attribution, battery, box, empty_at, energy, weather
 from app.operations.limits import check_round, far_stops, search_limits
 from app.operations.vans import van_of
 from app.schemas.base import (
@@ -94,7 +94,12 @@ def plan_response(
             energy_share=EnergyShare(**result.energy_share),
             grid_kwh=result.grid_kwh,
         ),
-        battery=battery(result.battery, result.first_infeasible_leg, result.battery_loss_kwh),
+        battery=battery(
+            result.battery,
+            result.first_infeasible_leg,
+            result.battery_loss_kwh,
+            empty_at(result),
+        ),
         weather=weather(result.weather, result.weather_source, result.weather_days),
         timezone=result.timezone,
         box=box(

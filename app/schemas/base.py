@@ -4,6 +4,7 @@ battery, weather and box answers, and the problem document."""
 
 from __future__ import annotations
 
+import datetime as dt
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, get_args
 
 from pydantic import (
@@ -331,6 +332,26 @@ class Point(ApiModel):
     coordinates: tuple[float, float] = Field(..., description="[lon, lat] in degrees (WGS 84).")
 
 
+class RunsEmptyOut(ApiModel):
+    """Where and when the battery would run empty, and the energy it lacks for the day."""
+
+    at: dt.datetime = Field(
+        ...,
+        description="When the charge reaches 0, local time (by the charge's fall over the "
+        "leg or the visit it falls in).",
+    )
+    where: str = Field(
+        ...,
+        description="On which leg (\"between 'a' and 'b'\") or at which visit (\"at 'b'\") it "
+        "falls to 0.",
+    )
+    missing_kwh: float = Field(
+        ...,
+        description="The energy the day needs beyond a full use of the battery [kWh]: −min_soc × "
+        "usable_capacity_kwh.",
+    )
+
+
 class BatteryOut(ApiModel):
     """Whether the battery holds out with its reserve."""
 
@@ -342,7 +363,8 @@ class BatteryOut(ApiModel):
     min_soc: float = Field(
         ...,
         description="Lowest state of charge [–]. Never clipped: below 0 it is the energy the "
-        "battery does not hold, as a share of usable_capacity_kwh (the van would stop there).",
+        "battery does not hold, as a share of usable_capacity_kwh (the van would stop where "
+        "runs_empty says).",
     )
     reserve_soc: float | None = Field(
         None, description="The reserve the battery was held to: battery.min_soc [–]."
@@ -370,6 +392,11 @@ class BatteryOut(ApiModel):
         None,
         description="Index in legs[] of the leg (or the stop after it) that breaks the "
         "reserve first; null when feasible.",
+    )
+    runs_empty: RunsEmptyOut | None = Field(
+        None,
+        description="Where and when the battery would run empty and the energy it lacks "
+        "(min_soc below 0); null while it holds any charge.",
     )
 
 

@@ -204,3 +204,43 @@ def test_a_stop_far_from_the_depot_is_planned_with_a_warning_naming_it(client):
     assert not any("from the depot" in w for w in plain)
     near = app_client(far_stop_km=2.0).post("/v1/plans", json=PLAN_EXAMPLE).json()["warnings"]
     assert 0 < sum("from the depot" in w for w in near) <= len(PLAN_EXAMPLE["stops"])
+
+
+@pytest.mark.parametrize("usable_kwh", [0.1, 2.0])
+def test_a_battery_that_runs_empty_says_where_when_and_what_it_lacks(client, usable_kwh):
+    """An audit read min_soc −18.2 on a 0.1 kWh battery: a battery that cannot exist. Where
+    the charge reaches 0 — the leg or the visit, the moment by its fall — and the energy the
+    day lacks are said beside it (a figure of the answer's own: −min_soc × the capacity)."""
+    body = PLAN_EXAMPLE | {"battery": {"usable_capacity_kwh": usable_kwh}}
+    battery = client.post("/v1/plans", json=body).json()
+    empty = battery["battery"]["runs_empty"]
+    legs, min_soc = battery["legs"], battery["battery"]["min_soc"]
+    assert min_soc < 0 and empty is not None
+    assert empty["missing_kwh"] == pytest.approx(
+        -min_soc * battery["battery"]["usable_capacity_kwh"]
+    )
+    # the first leg or visit whose charge ends below 0, at its moment by linear interpolation
+    spans = [(g["depart"], g["arrive"], g["soc_start"], g["soc_end"], g) for g in legs] + [
+        (v["arrive"], v["depart"], v["soc_arrival"], v["soc_departure"], v)
+        for v in battery["visits"]
+    ]
+    begin, end, soc_0, soc_1, where = min(
+        (s for s in spans if s[3] < 0), key=lambda s: dt.datetime.fromisoformat(s[0])
+    )
+    first, last, at = (dt.datetime.fromisoformat(t) for t in (begin, end, empty["at"]))
+    assert first <= at <= last
+    if soc_0 > 0:
+        share = soc_0 / (soc_0 - soc_1)
+        assert (at - first).total_seconds() == pytest.approx(
+            (last - first).total_seconds() * share, abs=1e-3
+        )
+    expected = (
+        f"between '{where['from_id']}' and '{where['to_id']}'" if "from_id" in where
+        else f"at '{where['id']}'"
+    )  # fmt: skip
+    assert empty["where"] == expected
+
+
+def test_a_battery_that_holds_a_charge_has_no_empty_moment(client):
+    answer = client.post("/v1/plans", json=PLAN_EXAMPLE).json()
+    assert answer["battery"]["min_soc"] > 0 and answer["battery"]["runs_empty"] is None
