@@ -31,6 +31,7 @@ from collections.abc import Awaitable, Callable
 from concurrent.futures import CancelledError as FutureCancelledError
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeoutError
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
 from pebble import ProcessExpired, ProcessPool
@@ -97,6 +98,14 @@ def _initialize_worker(parent_pid: int, log_level: str) -> None:
     # handler would only run when the search returns): the operating system's default.
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     _die_with_parent(parent_pid)
+
+
+def pool_broke(error: BaseException) -> bool:
+    """Whether ``error`` is Pebble's word that its pool broke under the task (a worker that died
+    while idle), not the task's own: another run, on a new pool, may succeed."""
+    return isinstance(error, BrokenProcessPool) or (
+        type(error) is RuntimeError and str(error) == "Unexpected error within the Pool"
+    )
 
 
 def ping() -> int:
@@ -223,8 +232,8 @@ class Executor:
         try:
             try:
                 return await self._await(self._schedule(fn, args))
-            except RuntimeError:
-                if self.pool.active:  # fn's own error
+            except RuntimeError as error:
+                if not pool_broke(error):
                     raise
             # the pool broke under it (a worker died while idle): once more on a new one
             return await self._await(self._schedule(fn, args))

@@ -25,7 +25,7 @@ from pebble import ProcessExpired
 from sqlalchemy.exc import OperationalError
 
 from app.errors import core_problem, problem_body, service_problem
-from app.execution import UnavailableError
+from app.execution import UnavailableError, pool_broke
 from app.jobs.store import JobStore, JobView
 from app.settings import Settings
 from core.exceptions import CoreError, ServiceUnavailableError
@@ -82,7 +82,7 @@ def failure(error: BaseException) -> tuple[dict[str, Any], bool]:
         return core_problem(error), False
     if isinstance(error, ServiceUnavailableError):
         return service_problem(error), True
-    if isinstance(error, UnavailableError | ProcessExpired):
+    if isinstance(error, UnavailableError | ProcessExpired) or pool_broke(error):
         reason = error.reason if isinstance(error, UnavailableError) else "its worker was lost"
         return problem_body(503, "Service unavailable", reason, service="workers"), True
     _log.error("job failed unexpectedly", exc_info=error)

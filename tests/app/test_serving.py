@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import multiprocessing
+import os
 import signal
 import time
 
@@ -12,7 +13,7 @@ import httpx
 import pytest
 from pebble import ProcessPool
 
-from app.execution import WorkerPool
+from app.execution import WorkerPool, ping, pool_broke
 from benchmarks.common import Server
 from tests.app.serving import alive, children, heap_kept_after_churn_bytes, long_plan
 
@@ -170,3 +171,31 @@ def test_workers_keep_freed_memory_for_the_next_simulation():
         workers.stop()
     assert untuned < 1 << 20
     assert tuned > 6 << 20
+
+
+def test_a_pool_a_dead_idle_worker_broke_is_replaced():
+    """Pebble marks its whole pool broken when a worker dies while idle (the kernel's
+    out-of-memory killer): every later task failed. The next task gets a new pool."""
+    workers = WorkerPool(2)
+    try:
+        workers.warm()
+        pid = workers.schedule(ping, ()).result(timeout=60)
+        os.kill(pid, signal.SIGKILL)
+        deadline = time.monotonic() + 10
+        while workers._pool is not None and workers._pool.active:  # Pebble notices
+            assert time.monotonic() < deadline, "the pool never noticed its dead worker"
+            time.sleep(0.05)
+        assert not workers.active
+        again = workers.schedule(ping, ()).result(timeout=60)
+        assert again != pid and workers.active
+    finally:
+        workers.stop()
+
+
+def test_only_pebbles_own_breakage_is_taken_for_a_broken_pool():
+    from concurrent.futures.process import BrokenProcessPool
+
+    assert pool_broke(RuntimeError("Unexpected error within the Pool"))
+    assert pool_broke(BrokenProcessPool("All workers expired"))
+    assert not pool_broke(RuntimeError("a task's own error"))
+    assert not pool_broke(ValueError("Unexpected error within the Pool"))
