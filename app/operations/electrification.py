@@ -15,7 +15,12 @@ from app import connectors
 from app.operations.vans import van_of
 from app.schemas.studies import ElectrificationRequest, ElectrificationResponse
 from app.settings import Settings
-from core.exceptions import CoreError, ServerLimitError, TooMuchToWaitForError
+from core.exceptions import (
+    CoreError,
+    InvalidParameterError,
+    ServerLimitError,
+    TooMuchToWaitForError,
+)
 from core.physics.weather import HourlyWeather
 from core.planning.electrification.model import (
     Candidate,
@@ -55,6 +60,18 @@ def electrification_problem(
             raise error.under(f"candidates[{index}]") from None
         if strategy is not None:
             van = van.model_copy(update={"refrigeration": strategy})
+            bare = next((i for i, r in enumerate(request.routes) if r.product is None), None)
+            if (
+                strategy.strategy == "optimal"
+                and van.cargo_box.product is None
+                and bare is not None
+            ):
+                raise InvalidParameterError(
+                    "strategy 'optimal' keeps goods in their band, and there are none to keep: "
+                    f"routes[{bare}] has no product and candidates[{index}]'s cargo_box none; "
+                    "give the route its product, or the candidate's box its goods",
+                    f"candidates[{index}].refrigeration" if own else "refrigeration",
+                )
         candidates.append(Candidate(id=candidate.id, van=van))
     problem = ElectrificationProblem(
         **fields_of(request, StudyFields),

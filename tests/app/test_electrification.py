@@ -224,6 +224,29 @@ def test_a_candidates_own_strategy_runs_with_each_routes_goods():
         assert optimal["energy_kwh_mean"][unit] < thermostat["energy_kwh_mean"][unit]
 
 
+@pytest.mark.parametrize("whose", ["candidate", "study"])
+def test_an_optimal_strategy_without_goods_names_the_strategy_sent(whose):
+    """No route names its product and no candidate's box its goods: the field named is the
+    strategy as sent — the candidate's or the study's — not routes[0].product, which the
+    request does not have (an audit's)."""
+    strategy = {"strategy": "optimal"}
+
+    def change(b: dict) -> None:
+        for c in b["candidates"]:
+            c.pop("cargo_box", None)
+        for r in b["routes"]:
+            r.pop("product", None)
+        if whose == "candidate":
+            b["candidates"][1]["refrigeration"] = strategy
+        else:
+            b["refrigeration"] = strategy
+
+    response = app_client().post(PATH, json=_with(change))
+    assert response.status_code == 422, response.text
+    field = "candidates[1].refrigeration" if whose == "candidate" else "refrigeration"
+    assert [e["field"] for e in response.json()["errors"]] == [field], response.json()
+
+
 def _archived(body: dict) -> dict:
     """The example in 2025 (archived: a year gone), on its first days, from the archive."""
     return body | {
