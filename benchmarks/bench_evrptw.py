@@ -21,6 +21,7 @@ never uses less energy than the instance's, so what the product plans holds ther
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import re
@@ -120,8 +121,11 @@ def fleet_request(day: Scaled, time_limit_s: float) -> dict[str, Any]:
         return {"lat": 48.0 + dy / 111_000, "lon": 16.0 + dx / 74_000}
 
     def window(k: int) -> tuple[int, int]:
+        """Rounded inwards to whole minutes, but a minute wide at least (some windows of
+        the set are narrower than a minute once scaled)."""
         a, b = problem.ready[k] * day.unit, problem.due[k] * day.unit
-        return math.ceil(a - 1e-9), min(math.floor(b + 1e-9), DAY_END_MIN)
+        opens = math.ceil(a - 1e-9)
+        return opens, max(min(math.floor(b + 1e-9), DAY_END_MIN), opens + 1)
 
     return {
         "date": "2026-04-15",
@@ -235,10 +239,14 @@ def _over_http(url: str, timeout_s: float) -> Any:
 def evrptw_tables(budget_s: float = BUDGET_S) -> None:
     """Every instance over HTTP at ``budget_s``, and the sum by class."""
     known = best_known()
-    instances = [read(path) for path in sorted(FOLDER.glob("*_21.txt"))]
+    by_class: dict[str, list[Instance]] = {}
+    for path in sorted(FOLDER.glob("*_21.txt")):
+        by_class.setdefault(re.sub(r"\d\d_21$", "", path.stem), []).append(read(path))
+    # the classes in turn, so that a run cut short has seen each
+    instances = [i for group in itertools.zip_longest(*by_class.values()) for i in group if i]
     server = Server({"COLDROUTE_MAX_TIME_LIMIT_S": str(max(budget_s, 60))}).start()
     rows = []
-    by_class: dict[str, list[tuple[int, int, float, float]]] = {}
+    found: dict[str, list[tuple[int, int, float, float]]] = {}
     try:
         plan = _over_http(server.url, budget_s * 4 + 60)
         kwh_per_km, short = linear_kwh_per_km(plan)
@@ -253,7 +261,7 @@ def evrptw_tables(budget_s: float = BUDGET_S) -> None:
             customers = len(instance.problem.customers)
             used = answer["totals"]["vehicles_used"]
             kind = re.sub(r"\d\d_21$", "", instance.name)  # c101_21: c1
-            by_class.setdefault(kind, []).append(
+            found.setdefault(kind, []).append(
                 (used - vans, customers - served, distance / best - 1, wall_s)
             )
             rows.append(
@@ -269,6 +277,7 @@ def evrptw_tables(budget_s: float = BUDGET_S) -> None:
                     answer["solver"]["stopped_by"],
                 ]
             )
+            print("| " + " | ".join(str(cell) for cell in rows[-1]) + " |", flush=True)
     finally:
         server.close()
     print_table(
@@ -303,15 +312,15 @@ def evrptw_tables(budget_s: float = BUDGET_S) -> None:
         [
             [
                 kind,
-                len(found),
-                f"{np.mean([f[0] for f in found]):+.2f}, {max(f[0] for f in found):+d}",
-                f"{sum(f[0] <= 1 for f in found)}/{len(found)}",
-                sum(f[1] for f in found),
-                f"{np.mean([f[2] for f in found]) * 100:+.1f} %, "
-                f"{max(f[2] for f in found) * 100:+.1f} %",
-                f"{max(f[3] for f in found):.0f}",
+                len(results),
+                f"{np.mean([r[0] for r in results]):+.2f}, {max(r[0] for r in results):+d}",
+                f"{sum(r[0] <= 1 for r in results)}/{len(results)}",
+                sum(r[1] for r in results),
+                f"{np.mean([r[2] for r in results]) * 100:+.1f} %, "
+                f"{max(r[2] for r in results) * 100:+.1f} %",
+                f"{max(r[3] for r in results):.0f}",
             ]
-            for kind, found in sorted(by_class.items())
+            for kind, results in sorted(found.items())
         ],
     )
 
