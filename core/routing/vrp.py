@@ -152,7 +152,10 @@ class RoutingOutcome:
 
 
 def solve_routes(
-    problem: RoutingInput, effort: Effort, initial: list[list[int]] | None = None
+    problem: RoutingInput,
+    effort: Effort,
+    initial: list[list[int]] | None = None,
+    polish: bool = True,
 ) -> RoutingOutcome | None:
     """Routes for every van; None when the search finds no solution.
 
@@ -165,6 +168,9 @@ def solve_routes(
         same routes for the same effort unless the deadline stops the search (``ended``).
     initial
         Routes to start from (stops per van); ignored when they break a constraint.
+    polish
+        Whether OR-Tools takes over PyVRP's routes that break an energy budget; else they are
+        trimmed to it (a fleet that will charge: the charging search plans them again).
     """
     # OR-Tools' model has no reloads: routes that reload are PyVRP's, trimmed to the budget.
     reloads = any(v.max_reloads for v in problem.vehicles)
@@ -179,7 +185,7 @@ def solve_routes(
             None if polished is None else replace(polished, ended=combined([ended, polished.ended]))
         )
     fitting = [_within_energy(problem, v, r) for v, r in enumerate(found)]
-    if reloads:
+    if reloads or not polish:
         return RoutingOutcome(fitting, ended)
     polished = _ortools_routes(problem, effort, fitting)
     # OR-Tools may find less (or reject the start and begin afresh): PyVRP's routes,

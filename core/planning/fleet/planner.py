@@ -549,7 +549,7 @@ def search(
     # a limit too short for the verification's reserve still leaves the search half of it
     reserve_s = min(verification_reserve_s(day), effort.left_s() / 2)
     share = CHARGING_FIRST_SHARE if charging else FIRST_SOLVE_SHARE
-    solved = _solved(day, times, minimize_vehicles, (effort, share), reserve_s)
+    solved = _solved(day, times, minimize_vehicles, (effort, share), reserve_s, not charging)
     routes, results, ends = solved.routes, solved.results, solved.ends
     left_out: dict[int, Failure] = {}
     for v, failure in solved.failures.items():
@@ -608,11 +608,15 @@ def _solved(
     minimize_vehicles: bool,
     effort: tuple[Effort, float],
     reserve_s: float,
+    polish: bool = True,
 ) -> _Solved:
     """Solve (the first with its share of ``effort``'s work, re-solves
     :data:`RESOLVE_SHARE`), simulate
     each route, and solve again from the routes that held with the budgets of those that ran
-    short made smaller, until every route holds or :data:`MAX_RESOLVES` re-solves are spent."""
+    short made smaller, until every route holds or :data:`MAX_RESOLVES` re-solves are spent.
+    ``polish``: routes over an energy budget go to OR-Tools (not where charging follows: the
+    charging search plans them again, and OR-Tools, counted by its solutions, once took the
+    whole limit there)."""
     whole, first_share = effort
     budgets = [
         e.budget_j if shift.battery_enforced else None
@@ -635,6 +639,7 @@ def _solved(
             routing_input(rules, minimize_vehicles),
             whole.share(share).keeping(reserve_s),
             initial,
+            polish,
         )
         rounds += 1
         ends.append(outcome.ended if outcome is not None else "work")
