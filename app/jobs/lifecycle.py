@@ -168,7 +168,13 @@ class Lifecycle:
         return "failed"
 
     def failed(self, job: JobView, error: BaseException) -> Ending:
-        """Retry a run that failed, after its backoff, if another may succeed; else fail."""
+        """Retry a run that failed, after its backoff, if another may succeed; else fail. A
+        run the pool broke under before it ran (a worker dead while idle) is no attempt: it
+        goes back to the queue at once, not counted."""
+        if pool_broke(error):
+            _log.warning("job %s: the worker pool broke under it; queued again", job.id)
+            self.stored(lambda: self.store.requeue(job.id, self.runner, count=False))
+            return "retrying"
         problem, retryable = failure(error)
         wait_s = self.policy.retry_after_s(job.attempts) if retryable else None
         if wait_s is not None:

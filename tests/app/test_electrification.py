@@ -152,7 +152,7 @@ def _with(change) -> dict:
                 b.update(refrigeration={"strategy": "optimal"}),
                 [c.pop("cargo_box") for c in b["candidates"]],
             ),
-            "routes[0].product",
+            "refrigeration",  # the strategy as sent (routes[0].product was not sent)
         ),
     ],
 )

@@ -92,7 +92,11 @@ def test_a_fleet_plan_job_answers_what_the_endpoint_answers(server):
     assert response.status_code == 202 and response.json()["type"] == "fleet-plan"
     done = wait_for(server.url, response.json()["id"])
     assert done["status"] == "succeeded", done
-    direct = httpx.post(f"{server.url}/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE, timeout=60).json()
+    # the job's work again on the endpoint: on a busy machine the clock may have cut the job
+    replay = {"replay": done["result"]["solver"]["replay"]}
+    direct = httpx.post(
+        f"{server.url}/v1/fleet-plans", json=FLEET_PLAN_EXAMPLE | replay, timeout=60
+    ).json()
     for answer in (done["result"], direct):
         answer["solver"].pop("runtime_s")
         for route in answer["routes"]:

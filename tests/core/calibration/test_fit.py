@@ -55,16 +55,23 @@ def as_logged(step_power_w: np.ndarray, n: int) -> np.ndarray:
 
 
 def measured_trip(
-    van: VanParams, name: str, k: int, rng, noise_w: float, thermometer: bool = True
+    van: VanParams,
+    name: str,
+    k: int,
+    rng,
+    noise_w: float,
+    thermometer: bool = True,
+    channel: str = "battery_power_w",
 ) -> MeasuredTrip:
-    """Cycle ``name`` driven by ``van`` on a day at 18 + 2·k °C, its battery power logged with
-    independent noise of ``noise_w``, and the outside temperature unless not ``thermometer``."""
+    """Cycle ``name`` driven by ``van`` on a day at 18 + 2·k °C, its ``channel``'s power
+    logged with independent noise of ``noise_w``, and the outside temperature unless not
+    ``thermometer``."""
     drive = cycle(name)
     start = START + dt.timedelta(hours=k)
     outside_c = 18.0 + 2 * k
     weather = Weather(t_min_c=outside_c, t_max_c=outside_c)
     result = simulate(drive.speed_mps, drive.dt_s, start, VIENNA, van, weather=weather)
-    battery_w = np.sum([result.power_w[c] for c in CHANNELS["battery_power_w"]], axis=0)
+    power_w = np.sum([result.power_w[c] for c in CHANNELS[channel]], axis=0)
     n = drive.speed_mps.size
     return MeasuredTrip(
         id=f"{name}-{k}",
@@ -72,7 +79,7 @@ def measured_trip(
         location=VIENNA,
         time_s=np.arange(n) * drive.dt_s,
         speed_mps=drive.speed_mps,
-        measured_w={"battery_power_w": as_logged(battery_w, n) + rng.normal(0, noise_w, n)},
+        measured_w={channel: as_logged(power_w, n) + rng.normal(0, noise_w, n)},
         ambient_c=np.full(n, outside_c) if thermometer else None,
     )
 
@@ -357,23 +364,10 @@ def test_a_parameter_no_measured_power_depends_on_gets_no_interval_and_a_warning
     null interval and nothing saying why."""
     truth = PRESETS["ev-van-3.5t-reefer"].van()
     rng = np.random.default_rng(5)
-    trips = []
-    for k, name in enumerate(["udds", "hwfet"]):
-        drive = cycle(name)
-        n = drive.speed_mps.size
-        result = simulate(drive.speed_mps, drive.dt_s, START, VIENNA, truth)
-        traction_w = np.sum([result.power_w[c] for c in CHANNELS["traction_power_w"]], axis=0)
-        trips.append(
-            MeasuredTrip(
-                id=f"{name}-{k}",
-                start=START,
-                location=VIENNA,
-                time_s=np.arange(n) * drive.dt_s,
-                speed_mps=drive.speed_mps,
-                measured_w={"traction_power_w": as_logged(traction_w, n) + rng.normal(0, 50, n)},
-                ambient_c=np.full(n, 20.0),
-            )
-        )
+    trips = [
+        measured_trip(truth, name, k, rng, 50.0, channel="traction_power_w")
+        for k, name in enumerate(["udds", "hwfet"])
+    ]
     parameters = [FitParameter(name="drag_coefficient"), FitParameter(name="cop")]
     fit = calibrate(truth, trips, parameters)
     cop = next(p for p in fit.parameters if p.name == "cop")

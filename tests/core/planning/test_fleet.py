@@ -340,7 +340,7 @@ def test_a_stop_the_search_left_out_goes_to_an_idle_van_that_serves_it_alone(mon
     east = [ids.index(i) + 1 for i in ("E1", "E2", "E3")]
     west = [ids.index(i) + 1 for i in ("W1", "W2")]  # W3 left out
 
-    def ran_out(_input, _budget_s, _initial=None):
+    def ran_out(_input, _budget_s, _initial=None, _polish=True):
         return RoutingOutcome([east, west, [], []])
 
     monkeypatch.setattr(fleet_module, "solve_routes", ran_out)
