@@ -362,7 +362,10 @@ def test_sigkill_of_a_celery_worker_takes_its_solvers_along(broker, services):
     try:
         job_id = submit(server.url, {"type": "plan", "request": long_plan(300, 40)}).json()["id"]
         wait_for(server.url, job_id, states=("running",), timeout=60)
-        solvers = children(worker.process.pid)
+        # claimed ("running") a moment before its pool starts: wait for the solvers
+        deadline = time.monotonic() + 30
+        while not (solvers := children(worker.process.pid)) and time.monotonic() < deadline:
+            time.sleep(0.1)
         assert solvers
         os.kill(worker.process.pid, signal.SIGKILL)  # the worker alone, not its group
         worker.process.wait()
