@@ -388,7 +388,9 @@ def record() -> dict[str, Any]:
     from app.schemas.simulate import SimulateRequest
     from app.schemas.studies import ElectrificationRequest, ScenariosRequest, SpeedSweepRequest
     from app.settings import Settings
+    from core.routing.tsp import prepare
 
+    prepare()  # as the service's workers: no example pays for loading the compiled searches
     # The calibration's record goes to a database of its own, not to the checkout's.
     database = tempfile.mkdtemp(prefix="coldroute-examples-")
     settings = Settings(database_url=f"sqlite:///{database}/examples.db")

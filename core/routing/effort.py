@@ -16,13 +16,15 @@ Rates, measured on the reference machine (uniform and clustered instances):
 
 - the round trip's local search (:mod:`core.routing.ils`): kicks per second by the number of
   places, interpolated log-log in :data:`KICKS_PER_S`;
-- PyVRP's iterated local search: iterations per second by the number of clients, every
-  stop required, interpolated log-log in :data:`PYVRP_ITERATIONS_PER_S` (25: 5,200; 100:
-  1,950; 1,000: 480), :data:`PYVRP_OPTIONAL_SHARE` of that with every stop optional — about
-  a tenth below the slower end of what the fleet's model runs at on Solomon's and
-  Gehring–Homberger's instances (25 clients 5,400–6,200 a second; 100: R201 1,870, R101
-  2,130, C101 3,520; 1,000: R1_10_1 620, C1_10_1 1,360), so that a search of tight windows
-  and long routes ends within its time and one of clusters ends early;
+- PyVRP's iterated local search (:mod:`core.routing.pyvrp_run`): a time per iteration and a
+  time per move its local search evaluates, each linear in the number of clients
+  (:data:`PYVRP_ITERATION_S`, :data:`PYVRP_MOVE_S`), fitted on the fleet's models of
+  Solomon's instances (25 and 100 clients) and Gehring–Homberger's six classes (200, 400 and
+  1,000): within −28 %…+27 % of the time each run took, where iterations alone were out by up
+  to 2.5 times (an iteration of a clustered day, C1 or C2, evaluates half the moves of one of
+  random places). Fitted on two runs at once (one per core, 20 % slower than one alone), then
+  scaled to one alone: default requests of 25, 100 and 1,000 stops used 50–74 % of their limit
+  with the fit as measured (``benchmarks/bench_limits.py``);
 - OR-Tools' guided local search (:mod:`core.routing.vrp`): ``500 · (20 / places)^1.4``
   solutions per second (20 places: 500; 40: 190; 100: 52; 200: 20), on random instances with
   windows and an energy budget (long runs: the first solutions come faster);
@@ -46,10 +48,14 @@ SearchEnd = Literal["work", "proof", "time_limit"]
 #: Kicks per reference second of the round trip's local search, by places.
 KICKS_PER_S = ((20, 14_000), (40, 9_700), (80, 8_900), (150, 6_400), (300, 3_800),
                (600, 2_500), (1_000, 1_800))  # fmt: skip
-#: PyVRP's iterations per reference second by clients, every stop required.
-PYVRP_ITERATIONS_PER_S = ((25, 5_200), (100, 1_950), (1_000, 480))
-#: The share of those with every stop optional (each a prize: a slower search).
-PYVRP_OPTIONAL_SHARE = 0.53
+#: PyVRP's reference seconds per iteration, ``a + b · clients`` (the loop around the local
+#: search: perturbation, copies of the solution, the acceptance test).
+PYVRP_ITERATION_S = (34e-6, 0.16e-6)
+#: PyVRP's reference seconds per move its local search evaluates, ``a + b · clients``.
+PYVRP_MOVE_S = (27e-9, 0.034e-9)
+#: What those cost with every stop optional (each a prize): its moves are quicker to evaluate
+#: (0.47–0.69 of the time the same count takes with every stop required, 100 and 1,000 clients).
+PYVRP_OPTIONAL_COST = 0.57
 #: OR-Tools' routing solutions per reference second:
 #: ``ORTOOLS_RATE · (ORTOOLS_SIZE / places)^ORTOOLS_EXPONENT``.
 ORTOOLS_RATE = 500.0
@@ -169,10 +175,14 @@ class Effort:
         """The round trip's local search: kicks in this work."""
         return max(int(self.work_s * _interpolated(KICKS_PER_S, places)), 0)
 
-    def pyvrp_iterations(self, clients: int, optional: bool = False) -> int:
-        """PyVRP's iterations in this work, its stops required or ``optional``."""
-        rate = _interpolated(PYVRP_ITERATIONS_PER_S, clients)
-        return max(int(self.work_s * rate * (PYVRP_OPTIONAL_SHARE if optional else 1.0)), 1)
+    @staticmethod
+    def pyvrp_spent_s(iterations: int, moves: int, clients: int, optional: bool = False) -> float:
+        """The work [reference s] of PyVRP's ``iterations`` in which its local search
+        evaluated ``moves``, on ``clients``, its stops required or ``optional``."""
+        iteration_s = PYVRP_ITERATION_S[0] + PYVRP_ITERATION_S[1] * clients
+        move_s = PYVRP_MOVE_S[0] + PYVRP_MOVE_S[1] * clients
+        spent_s = iterations * iteration_s + moves * move_s
+        return spent_s * (PYVRP_OPTIONAL_COST if optional else 1.0)
 
     def ortools_solutions(self, places: int) -> int:
         """OR-Tools' routing solutions in this work."""

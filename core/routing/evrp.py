@@ -44,6 +44,7 @@ import numpy as np
 import pyvrp
 
 from core.arrays import FloatArray
+from core.routing import pyvrp_run
 from core.routing.effort import Effort, SearchEnd
 from core.routing.points import Closed, Span, full_spans
 from core.routing.stations import (
@@ -310,27 +311,11 @@ def _customer_routes(instance: EvrpInstance, effort: Effort, charge_share: float
         [distance] * len(durations),  # type: ignore[list-item]  # PyVRP's stubs: ndarray[int]
         durations,
     )
-    result = pyvrp.solve(
-        data,
-        stop=_Iterations(effort.pyvrp_iterations(len(customers)), effort),
-        seed=effort.seed,
-        display=False,
-    )
+    result, _ = pyvrp_run.solve(data, effort)
     return [
         (route.vehicle_type(), [customers[v.idx] for v in route.schedule() if v.is_client()])
         for route in result.best.routes()
     ]
-
-
-class _Iterations:
-    """PyVRP's stopping criterion: its iterations, or the effort's deadline first."""
-
-    def __init__(self, iterations: int, effort: Effort) -> None:
-        self.iterations, self.watch, self.done = iterations, effort.watch(), 0
-
-    def __call__(self, best_cost: float) -> bool:
-        self.done += 1
-        return self.done > self.iterations or self.watch.passed(self.done)
 
 
 class _Priced:

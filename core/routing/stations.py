@@ -163,6 +163,21 @@ def route_with_stations(
     )
 
 
+def warm_up() -> None:
+    """Load (or, once per installation, compile) the compiled station search, as
+    :func:`core.routing.ils.warm_up` does the round trip's: loaded in a request's first
+    charging search instead, it took its time limit (a 40-stop round's, 2 s) before its first
+    look at the clock."""
+    size = 4  # the depot, two customers, a station
+    cost = np.ones((size, size)) - np.eye(size)
+    facts = RouteFacts(
+        cost, cost, cost, np.zeros(size), np.full(size, 100.0), np.zeros(size),
+        np.full(size, 0.1), 1.5, 1.5, 0.0,
+    )  # fmt: skip
+    candidates = station_candidates(cost, np.array([3]))
+    route_with_stations(facts, np.array([0, 1, 2, 0]), candidates, Closed.of({3: [(0.0, 1.0)]}, 4))
+
+
 @njit(cache=True)
 def _labels(
     seq: NDArray[np.int64],

@@ -157,11 +157,13 @@ def solve_path(
 
 
 def prepare() -> None:
-    """Load the compiled local search now (about a second, once per process), not in the first
-    round of more than :data:`FULL_GRAPH_MAX_NODES` places: what worker processes do first."""
-    from core.routing import ils  # Numba's import is heavy: only processes that solve pay it
+    """Load the compiled searches now (about a second, once per process) — the round trip's
+    local search and the charging stations' labels — not in the first request that needs them:
+    what worker processes do first."""
+    from core.routing import ils, stations  # Numba's import is heavy: only solvers pay it
 
     ils.warm_up()
+    stations.warm_up()
 
 
 def _improve(cost: NDArray[np.int64], start: list[int], effort: Effort) -> tuple[list[int], bool]:

@@ -13,12 +13,12 @@ Two engines, each where it is strongest (``benchmarks/bench_fleet.py``):
 1. PyVRP's iterated local search (Wouda, Lan & Kool 2024) on windows, shifts and payload: on
    Solomon's instances within a fraction of a percent of the best known routes. A stop with
    several windows is a group of alternatives, one per window. Every stop is required at
-   first (its fastest search: 2–3 times the iterations per second of one with optional
-   stops); when that finds no routes serving them all within :data:`REQUIRED_SHARE` of its
-   work, the rest of the work goes to a search with every stop optional for a prize, so a
-   partial plan is there. It ends after its work's iterations (:mod:`core.routing.effort`) —
-   seeded, so the same routes for the same input and effort — or, cut short, at the deadline
-   (where it stopped is recorded, for a replay).
+   first (its fastest search); when that finds no routes serving them all within
+   :data:`REQUIRED_SHARE` of its work, the rest of the work goes to a search with every stop
+   optional for a prize, so a partial plan is there. It ends when its iterations and the
+   moves they evaluated make its work (:mod:`core.routing.pyvrp_run`) — seeded, so the same
+   routes for the same input and effort — or, cut short, at the deadline (where it stopped is
+   recorded, for a replay).
 2. OR-Tools' routing library with every constraint as a dimension, the energy budget
    included, and the cost of waiting for a window: it takes over PyVRP's routes when they
    break an energy budget (less the stops that do not fit) or when waiting has a cost,
@@ -38,6 +38,7 @@ import pyvrp
 from numpy.typing import NDArray
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
+from core.routing import pyvrp_run
 from core.routing.effort import Effort, SearchEnd, combined
 
 IntMatrix = NDArray[np.int64]
@@ -55,8 +56,6 @@ REQUIRED_SHARE = 0.2
 #: root between them met PyVRP on both. Fixed costs per van keep their scale: the search
 #: that empties a route needs the room. The bounds of the scale [objective units per s]:
 _SCALE_BOUNDS = (0.01, 100.0)
-#: PyVRP's cost of a solution that breaks a constraint.
-_INFEASIBLE = np.iinfo(np.int64).max
 #: The searches overshoot their limit by a few milliseconds; they get this much less [s].
 _STOP_MARGIN_S = 0.01
 #: Longest cap OR-Tools is given [s] (a day): a deadline that never comes is no number it takes.
@@ -164,8 +163,9 @@ def solve_routes(
     problem
         Places and vans.
     effort
-        The search's work (PyVRP's iterations, OR-Tools' solutions), deadline and seed: the
-        same routes for the same effort unless the deadline stops the search (``ended``).
+        The search's work (PyVRP's iterations and moves, OR-Tools' solutions), deadline and
+        seed: the same routes for the same effort unless the deadline stops the search
+        (``ended``).
     initial
         Routes to start from (stops per van); ignored when they break a constraint.
     polish
@@ -436,39 +436,10 @@ def _cost_scale(problem: RoutingInput, large_fixed: bool) -> float:
     return 1.0 if large_fixed else math.sqrt(_cost_per_s(problem))
 
 
-class _Stop:
-    """PyVRP's stopping criterion: its iterations (the work), or the deadline (a
-    :class:`~core.routing.effort.Watch` on the iterations) — and which of them stopped it.
-    With ``give_up`` (iterations and an effort whose deadline comes earlier), it also stops
-    when either is reached and no solution keeps every constraint yet; ``gave_up``: it
-    stopped without one, but for the deadline."""
-
-    def __init__(
-        self, iterations: int, effort: Effort, give_up: tuple[int, Effort] | None = None
-    ) -> None:
-        self.iterations, self.watch = iterations, effort.watch()
-        self.give_up = None if give_up is None else (give_up[0], give_up[1].watch())
-        self.done = 0
-        self.ended: SearchEnd = "work"
-        self.gave_up = False
-
-    def __call__(self, best_cost: float) -> bool:
-        self.done += 1
-        if self.watch.passed(self.done):
-            self.ended = "time_limit"
-            return True
-        spent = self.done > self.iterations
-        if self.give_up is not None and best_cost >= _INFEASIBLE:
-            iterations, moment = self.give_up
-            self.gave_up = spent or self.done > iterations or moment.passed(self.done)
-            return self.gave_up
-        return spent
-
-
 def _pyvrp_routes(
     problem: RoutingInput, effort: Effort, initial: list[list[int]] | None
 ) -> tuple[list[list[int]] | None, SearchEnd]:
-    """PyVRP's best feasible routes per van after the effort's iterations; None when it has
+    """PyVRP's best feasible routes per van after the effort's work; None when it has
     none; and how it stopped. Every stop required first; optional after
     :data:`REQUIRED_SHARE` of the work or of the time left without routes that serve them
     all."""
@@ -477,16 +448,14 @@ def _pyvrp_routes(
     model = _pyvrp_model(problem, required=True)
     if not model.client_node:
         return [[] for _ in problem.vehicles], "work"
-    clients = len(model.client_node)
-    iterations = effort.pyvrp_iterations(clients)
-    give_up = (int(iterations * REQUIRED_SHARE), effort.within(REQUIRED_SHARE))
-    result, stop = _pyvrp_search(model, effort, iterations, initial, give_up)
+    give_up = (REQUIRED_SHARE, effort.within(REQUIRED_SHARE))
+    start = _pyvrp_start(model, initial)
+    result, stop = pyvrp_run.solve(model.data, effort, initial=start, give_up=give_up)
     if stop.gave_up:
         model = _pyvrp_model(problem, required=False)
-        rest = effort.share(1.0 - stop.done / iterations)
-        result, stop = _pyvrp_search(
-            model, rest, rest.pyvrp_iterations(clients, optional=True), initial
-        )
+        rest = effort.share(stop.left_share())
+        start = _pyvrp_start(model, initial)
+        result, stop = pyvrp_run.solve(model.data, rest, optional=True, initial=start)
     routes: list[list[int]] = [[] for _ in problem.vehicles]
     taken = [0] * len(model.type_vans)
     for route in result.best.routes():
@@ -498,26 +467,6 @@ def _pyvrp_routes(
     if not result.is_feasible():  # the best it found, less the stops that break a rule
         routes = [_kept(problem, v, route) for v, route in enumerate(routes)]
     return routes, stop.ended
-
-
-def _pyvrp_search(
-    model: _PyvrpModel,
-    effort: Effort,
-    iterations: int,
-    initial: list[list[int]] | None,
-    give_up: tuple[int, Effort] | None = None,
-) -> tuple[pyvrp.Result, _Stop]:
-    """PyVRP's search on ``model`` for ``iterations`` under ``effort``'s deadline and seed."""
-    stop = _Stop(iterations, effort, give_up)
-    result = pyvrp.solve(
-        model.data,
-        stop=stop,
-        seed=effort.seed,
-        display=False,
-        collect_stats=False,
-        initial_solution=_pyvrp_start(model, initial),
-    )
-    return result, stop
 
 
 def _kept(problem: RoutingInput, v: int, route: list[int]) -> list[int]:

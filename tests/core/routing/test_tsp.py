@@ -211,3 +211,22 @@ def test_the_local_search_uncrosses_a_square():
     cost = np.rint(np.hypot(*(corners[:, None] - corners[None]).transpose(2, 0, 1))).astype(int)
     tour = _local_search_all(cost, np.array([0, 2, 1, 3]), neighbours(cost, 3))
     assert tour_cost(cost, [*tour.tolist(), 0]) == 4000
+
+
+def test_prepare_loads_every_compiled_search_a_request_may_need():
+    """A worker's warm-up (``prepare``) leaves no compiled search for a request to load under
+    its time limit: the round trip's and the charging stations' (a 40-stop round with chargers
+    on the way once took its 2 s limit loading the latter, before its first look at the
+    clock)."""
+    import subprocess
+    import sys
+
+    check = (
+        "from core.routing import ils, stations\n"
+        "from core.routing.tsp import prepare\n"
+        "compiled = [ils._local_search_all, ils._kicks, ils._length, stations._labels]\n"
+        "assert not any(f.signatures for f in compiled)\n"
+        "prepare()\n"
+        "assert all(f.signatures for f in compiled)\n"
+    )
+    subprocess.run([sys.executable, "-c", check], check=True, timeout=300)
