@@ -37,6 +37,9 @@ from benchmarks.evrptw import FOLDER, Instance, best_known, read
 
 #: The time limit of each plan [s] (``COLDROUTE_BENCH_EVRPTW_S`` shortens it).
 BUDGET_S = float(os.environ.get("COLDROUTE_BENCH_EVRPTW_S", "60"))
+#: Only these instances (``COLDROUTE_BENCH_EVRPTW_INSTANCES``: names, comma-separated, as
+#: ``c103_21``); every one when unset.
+ONLY = {name for name in os.environ.get("COLDROUTE_BENCH_EVRPTW_INSTANCES", "").split(",") if name}
 #: The last minute of the day a shift may end at.
 DAY_END_MIN = 1439
 #: Kilograms per unit of the instance's demand: light, so the van's mass hardly changes.
@@ -241,6 +244,8 @@ def evrptw_tables(budget_s: float = BUDGET_S) -> None:
     known = best_known()
     by_class: dict[str, list[Instance]] = {}
     for path in sorted(FOLDER.glob("*_21.txt")):
+        if ONLY and path.stem not in ONLY:
+            continue
         by_class.setdefault(re.sub(r"\d\d_21$", "", path.stem), []).append(read(path))
     # the classes in turn, so that a run cut short has seen each
     instances = [i for group in itertools.zip_longest(*by_class.values()) for i in group if i]
@@ -260,7 +265,7 @@ def evrptw_tables(budget_s: float = BUDGET_S) -> None:
             served = sum(len(route["stops"]) for route in answer["routes"])
             customers = len(instance.problem.customers)
             used = answer["totals"]["vehicles_used"]
-            kind = re.sub(r"\d\d_21$", "", instance.name)  # c101_21: c1
+            kind = re.sub(r"\d\d(_21)?$", "", instance.name)  # c101 (c101_21.txt): c1
             found.setdefault(kind, []).append(
                 (used - vans, customers - served, distance / best - 1, wall_s)
             )

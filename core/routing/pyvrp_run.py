@@ -47,22 +47,21 @@ class Stop:
     def __init__(
         self,
         effort: Effort,
+        search: _Counted,
         clients: int,
         optional: bool,
         give_up: tuple[float, Effort] | None = None,
     ) -> None:
-        self.effort, self.clients, self.optional = effort, clients, optional
+        self.effort, self.search, self.clients, self.optional = effort, search, clients, optional
         self.watch = effort.watch()
         self.give_up = None if give_up is None else (give_up[0], give_up[1].watch())
-        self.search: _Counted | None = None
         self.done = 0
         self.ended: SearchEnd = "work"
         self.gave_up = False
 
     def spent_s(self) -> float:
         """The reference seconds its iterations and moves so far stand for."""
-        moves = 0 if self.search is None else self.search.moves
-        return self.effort.pyvrp_spent_s(self.done, moves, self.clients, self.optional)
+        return self.effort.pyvrp_spent_s(self.done, self.search.moves, self.clients, self.optional)
 
     def left_share(self) -> float:
         """The share of its work not yet spent."""
@@ -108,8 +107,7 @@ def solve(
     if initial is None:
         random = pyvrp.Solution.make_random(data, rng)
         initial = search(random, penalties.max_cost_evaluator(), exhaustive=True)
-    stop = Stop(effort, data.num_clients, optional, give_up)
-    stop.search = search
+    stop = Stop(effort, search, data.num_clients, optional, give_up)
     result = pyvrp.IteratedLocalSearch(data, penalties, search, initial, params.ils).run(
         stop, collect_stats=False, display=False
     )

@@ -46,7 +46,7 @@ def test_a_search_ends_when_its_iterations_and_moves_make_its_work(vans):
     result, stop = pyvrp_run.solve(instance(vans), Effort(work_s, math.inf, seed=2))
     assert stop.ended == "work" and result.is_feasible()
     assert work_s <= stop.spent_s() < work_s * 1.01
-    assert stop.search is not None and stop.search.moves > 100 * stop.done  # moves counted
+    assert stop.search.moves > 100 * stop.done  # moves counted
 
 
 def test_the_same_work_is_fewer_iterations_where_each_evaluates_more_moves():
@@ -56,7 +56,7 @@ def test_the_same_work_is_fewer_iterations_where_each_evaluates_more_moves():
     ends = {
         vans: pyvrp_run.solve(instance(vans), Effort(0.5, math.inf, seed=2))[1] for vans in (1, 12)
     }
-    moves = {vans: stop.search.moves / stop.done for vans, stop in ends.items()}  # type: ignore[union-attr]
+    moves = {vans: stop.search.moves / stop.done for vans, stop in ends.items()}
     assert moves[12] > 1.5 * moves[1]
     assert ends[12].done < ends[1].done / 1.3
 
