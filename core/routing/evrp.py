@@ -37,7 +37,7 @@ may not serve (pinned to others).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -690,28 +690,30 @@ class _Search(_Solution):
         routes cheaper and keeps them holding together, until none does — a route's stretch of
         customers turned round (2-opt), or two routes' ends exchanged (2-opt*: what ruin and
         recreate, moving customers one by one, does not do: a van's last stretch, charges
-        and all, handed to another)."""
+        and all, handed to another). The deadline is looked at before each change tried: one
+        pass over two long routes' ends takes seconds. A pass it cuts has changed nothing, so
+        a replay stopping before that pass ends the same."""
         end = self.spent_s + work_s
         watch = effort.watch()
         while self.spent_s < end:
-            if watch.passed(self.moves):
-                return "time_limit"
-            turned = any(self._turned_round(r) for r in range(len(self.routes)))
-            if not turned and not self._ends_exchanged():
+            for changed, now in self._changes():
+                if watch.passed(self.moves):
+                    return "time_limit"
+                if self._kept(changed, now):
+                    self.moves += 1
+                    break
+            else:
                 return "work"
-            self.moves += 1
         return "work"
 
-    def _turned_round(self, r: int) -> bool:
-        kind, route = self.routes[r]
-        now = self.cost(kind, route)
-        for i in range(len(route) - 1):
-            for j in range(i + 2, len(route) + 1):
-                if self._kept([(r, [*route[:i], *route[i:j][::-1], *route[j:]])], now):
-                    return True
-        return False
-
-    def _ends_exchanged(self) -> bool:
+    def _changes(self) -> Iterator[tuple[list[tuple[int, list[int]]], float]]:
+        """Each change :meth:`polish` tries, in order, with what the routes it changes cost
+        now: every route's stretches turned round, then every two routes' ends exchanged."""
+        for r, (kind, route) in enumerate(self.routes):
+            now = self.cost(kind, route)
+            for i in range(len(route) - 1):
+                for j in range(i + 2, len(route) + 1):
+                    yield [(r, [*route[:i], *route[i:j][::-1], *route[j:]])], now
         for a in range(len(self.routes)):
             for b in range(a + 1, len(self.routes)):
                 (ka, ra), (kb, rb) = self.routes[a], self.routes[b]
@@ -720,9 +722,7 @@ class _Search(_Solution):
                     for j in range(len(rb) + 1):
                         if (i, j) in ((0, 0), (len(ra), len(rb))):
                             continue  # the same routes
-                        if self._kept([(a, [*ra[:i], *rb[j:]]), (b, [*rb[:j], *ra[i:]])], now):
-                            return True
-        return False
+                        yield [(a, [*ra[:i], *rb[j:]]), (b, [*rb[:j], *ra[i:]])], now
 
     def _kept(self, changed: list[tuple[int, list[int]]], now: float) -> bool:
         """The routes ``changed`` (index, new customers) kept when they cost less than ``now``
