@@ -19,3 +19,9 @@ def client() -> TestClient:
     return app_client(
         max_stops=40, max_trace_samples=5000, max_body_bytes=200_000, max_time_limit_s=0.5
     )
+
+
+@pytest.fixture
+def client_default() -> TestClient:
+    """A client of the app with the default settings (a request's time limit up to 30 s)."""
+    return app_client()

@@ -63,12 +63,6 @@ def both_cores_busy() -> Iterator[None]:
         yield
 
 
-@pytest.fixture
-def client_default():
-    """A client of the app with the default settings (a request's time limit up to 30 s)."""
-    return app_client()
-
-
 @pytest.fixture(scope="module")
 def server() -> Iterator[Server]:
     started = Server({"COLDROUTE_WORKERS": "2", "COLDROUTE_JOB_SLOTS": "1"}).start()

@@ -104,7 +104,10 @@ def test_answer_examples_are_real_answers_of_the_request_examples(client):
         ("job", JobOut),
     ):
         model.model_validate(recorded[key], strict=False)
-    plan = client.post("/v1/plans", json=PLAN_EXAMPLE).json()
+    # With the work it did then, as the Swagger example sends it: a busy machine's clock does
+    # not cut it short.
+    replay = {"replay": recorded["replays"]["vienna-8-stops"]}
+    plan = client.post("/v1/plans", json=PLAN_EXAMPLE | replay).json()
     assert plan["tour"] == recorded["plan"]["tour"]
     assert plan["totals"] == recorded["plan"]["totals"]
     simulated = client.post("/v1/simulate", json=SIMULATE_EXAMPLE).json()
