@@ -80,22 +80,26 @@ def test_a_fleet_of_one_plans_the_round_plans_plans(client_default):
     # The same work for both, and time to do it: a busy machine's clock cuts neither search.
     limits = {"time_limit_s": 60, "work_s": default_work_s(1.0)}
     single = client.post("/v1/plans", json=plan_body | limits).json()
-    fleet_body = limits | {
-        key: plan_body[key]
-        for key in ("date", "timezone", "depot", "stops", "weather", "objective")
-    } | {
-        "vehicles": [
-            {
-                "id": "only",
-                "vehicle": plan_body["vehicle"],
-                "battery": plan_body["battery"],
-                "payload_kg": plan_body["payload_kg"],
-                "shift_start": plan_body["start_time"],
-                "shift_end": "23:59",
-            }
-        ],
-        "driver_aggressiveness": plan_body["driver_aggressiveness"],
-    }
+    fleet_body = (
+        limits
+        | {
+            key: plan_body[key]
+            for key in ("date", "timezone", "depot", "stops", "weather", "objective")
+        }
+        | {
+            "vehicles": [
+                {
+                    "id": "only",
+                    "vehicle": plan_body["vehicle"],
+                    "battery": plan_body["battery"],
+                    "payload_kg": plan_body["payload_kg"],
+                    "shift_start": plan_body["start_time"],
+                    "shift_end": "23:59",
+                }
+            ],
+            "driver_aggressiveness": plan_body["driver_aggressiveness"],
+        }
+    )
     fleet = client.post("/v1/fleet-plans", json=fleet_body).json()
     assert single["solver"]["stopped_by"] == fleet["solver"]["stopped_by"] == "work"
     route = fleet["routes"][0]

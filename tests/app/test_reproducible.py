@@ -23,7 +23,6 @@ from app.main import app
 from app.openapi_doc import RESPONSE_EXAMPLES
 from benchmarks.common import Server, busy_core
 from core.planning.model import default_work_s
-from tests.app.apps import app_client
 from tests.app.test_jobs import submit, wait_for
 
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "integrators" / "rounds.md"
