@@ -356,7 +356,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
         runner = CeleryDispatcher(store, settings)
     runner.start()
     app.state.runner = runner
-    await executor.warm_up()
+    await asyncio.gather(executor.warm_up(), asyncio.to_thread(app.state.routes.load))
     try:
         yield
     finally:

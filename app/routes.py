@@ -36,6 +36,11 @@ class RouteTemplates:
             for template, operations in ordered
         ]
 
+    def load(self) -> None:
+        """Build the OpenAPI document and its patterns now (1–2 s): at start-up, before the
+        first request's log line would have it built on the event loop."""
+        _ = self._patterns  # the cached property, computed once
+
     def template(self, path: str) -> str | None:
         """The documented template that ``path`` matches, if any."""
         for pattern, template, _ in self._patterns:

@@ -7,6 +7,7 @@ from dataclasses import replace
 
 from app import connectors
 from app.operations.answers import attribution, energy
+from app.operations.encoded import Encoded, encoded
 from app.operations.limits import check_fleet_size, far_stops, search_limits
 from app.operations.plan import plan_response
 from app.operations.vans import van_of
@@ -105,3 +106,9 @@ def fleet_response(
 def answer(request: FleetPlanRequest, result: FleetResult) -> FleetPlanResponse:
     """What the endpoint answers a fleet plan request with (as JSON)."""
     return fleet_response(result, request.include_geometry, request.include_profile)
+
+
+def fleet_answer(request: FleetPlanRequest, settings: Settings) -> Encoded:
+    """``POST /v1/fleet-plans``'s answer, planned and written out in the worker."""
+    result = run_fleet_plan(request, settings)
+    return encoded(answer(request, result), runtime_s=result.runtime_s)

@@ -7,6 +7,7 @@ from typing import Any
 
 from app import connectors
 from app.operations.answers import attribution, battery, box, empty_at, energy, weather
+from app.operations.encoded import Encoded, encoded
 from app.operations.limits import check_round, far_stops, search_limits
 from app.operations.vans import van_of
 from app.schemas.base import (
@@ -35,6 +36,9 @@ from app.schemas.plans import (
 from app.settings import Settings
 from core.planning.model import DayProfile, PlanFields, PlanProblem, PlanResult, fields_of
 from core.planning.round.planner import check, plan
+
+#: The media type of a round as a map (RFC 7946).
+GEOJSON = "application/geo+json"
 
 
 def plan_problem(request: PlanRequest, settings: Settings) -> PlanProblem:
@@ -126,6 +130,17 @@ def day_profile(profile: DayProfile) -> DayProfileOut:
 def answer(request: PlanRequest, result: PlanResult) -> PlanResponse:
     """What the endpoint answers a plan request with (as JSON)."""
     return plan_response(result, request.include_geometry, request.include_profile)
+
+
+def plan_answer(request: PlanRequest, settings: Settings, geojson: bool = False) -> Encoded:
+    """``POST /v1/plans``'s answer, planned and written out in the worker: as JSON, or as
+    GeoJSON for a map when ``geojson``."""
+    result = run_plan(request, settings)
+    runtime_s = result.solved.runtime_s
+    if geojson:
+        collection = plan_geojson(result, request.depot.lat, request.depot.lon)
+        return encoded(collection, GEOJSON, runtime_s)
+    return encoded(answer(request, result), runtime_s=runtime_s)
 
 
 def plan_geojson(result: PlanResult, depot_lat: float, depot_lon: float) -> PlanFeatureCollection:

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Request
+from fastapi import APIRouter, Body, Request, Response
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import FLEET_EXAMPLES
 from app.openapi_doc import request_examples
-from app.operations.fleet_plan import answer, run_fleet_plan
+from app.operations.fleet_plan import fleet_answer
 from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
 
 router = APIRouter(tags=["fleet"])
@@ -29,7 +29,7 @@ async def create_fleet_plan(
     http: Request,
     settings: SettingsDep,
     pool: ExecutorDep,
-) -> FleetPlanResponse:
+) -> Response:
     """Splits the stops across the vans (PyVRP's search, OR-Tools' where the battery binds; time
     windows, shifts, payload and each van's battery as constraints) and simulates every route's day
     in full: the charge never falls below a van's reserve, service starts inside a window, every van
@@ -37,6 +37,6 @@ async def create_fleet_plan(
     tightened and solved again (its work `work_s`, `time_limit_s` the cap); stops no van can
     serve are listed in `unassigned` with their reason. Solved in a worker process, as plans
     are."""
-    result = await pool.run(run_fleet_plan, request, settings, disconnected=http.is_disconnected)
-    http.app.state.metrics.solve.observe(result.runtime_s)
-    return answer(request, result)
+    made = await pool.run(fleet_answer, request, settings, disconnected=http.is_disconnected)
+    http.app.state.metrics.solve.observe(made.runtime_s)
+    return Response(made.body, media_type=made.media_type)

@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Annotated
 
-from fastapi import APIRouter, Body, Header, Request
-from fastapi.responses import JSONResponse
+from fastapi import APIRouter, Body, Header, Request, Response
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import PLAN_EXAMPLES
 from app.openapi_doc import request_examples
-from app.operations.plan import answer, plan_geojson, run_plan
+from app.operations.plan import GEOJSON, plan_answer
 from app.schemas.plans import PlanRequest, PlanResponse
 
 router = APIRouter(tags=["plans"])
-GEOJSON = "application/geo+json"
 
 
 def wants_geojson(accept: str | None) -> bool:
@@ -64,15 +62,14 @@ async def create_plan(
         str | None,
         Header(description="application/json (default) or application/geo+json for a map."),
     ] = None,
-) -> Any:
+) -> Response:
     """Orders the stops (a local search, CP-SAT's proof), simulates every leg and stop with the
     paper's model and says whether the battery holds out. With `COLDROUTE_OSRM_URL` set, distances,
     durations and each leg's speed profile come from the OSRM road router. Solved in a worker
     process; when every worker is busy the request waits in a bounded queue (503 with Retry-After
     beyond it)."""
-    result = await pool.run(run_plan, request, settings, disconnected=http.is_disconnected)
-    http.app.state.metrics.solve.observe(result.solved.runtime_s)
-    if wants_geojson(accept):
-        collection = plan_geojson(result, request.depot.lat, request.depot.lon)
-        return JSONResponse(collection.model_dump(mode="json"), media_type=GEOJSON)
-    return answer(request, result)
+    made = await pool.run(
+        plan_answer, request, settings, wants_geojson(accept), disconnected=http.is_disconnected
+    )
+    http.app.state.metrics.solve.observe(made.runtime_s)
+    return Response(made.body, media_type=made.media_type)

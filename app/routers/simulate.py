@@ -4,17 +4,23 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Request
+from fastapi import APIRouter, Body, Request, Response
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import SIMULATE_EXAMPLE, SIMULATE_TRACE_EXAMPLE
 from app.operations import simulate as operation
+from app.operations.encoded import answered
 from app.schemas.simulate import SimulateRequest, SimulateResponse
 
 router = APIRouter(tags=["simulation"])
 
 
-@router.post("/simulate", operation_id="simulateTrace", summary="Energy of one speed trace")
+@router.post(
+    "/simulate",
+    operation_id="simulateTrace",
+    summary="Energy of one speed trace",
+    response_model=SimulateResponse,
+)
 async def simulate_trace(
     request: Annotated[
         SimulateRequest,
@@ -34,9 +40,10 @@ async def simulate_trace(
     http: Request,
     settings: SettingsDep,
     pool: ExecutorDep,
-) -> SimulateResponse:
+) -> Response:
     """Per-consumer power and energy, state of charge and battery verdict along a trace you send
     (`speed_mps`, `dt_s`, `grade`) or one generated from a street type (`cycle`)."""
-    return await pool.run(
-        operation.simulate_trace, request, settings, disconnected=http.is_disconnected
+    made = await pool.run(
+        answered, operation.simulate_trace, request, settings, disconnected=http.is_disconnected
     )
+    return Response(made.body, media_type=made.media_type)

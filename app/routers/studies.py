@@ -6,12 +6,13 @@ import asyncio
 import time
 from typing import Annotated
 
-from fastapi import APIRouter, Body, File, Form, Request, UploadFile
+from fastapi import APIRouter, Body, File, Form, Request, Response, UploadFile
 from starlette.concurrency import run_in_threadpool
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import ELECTRIFICATION_EXAMPLE, SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
 from app.operations.electrification import merged_answer, plan_study, run_study_part
+from app.operations.encoded import answered
 from app.operations.studies import run_scenarios as scenarios
 from app.operations.studies import sweep_speeds as sweep
 from app.operations.telematics import with_history
@@ -28,7 +29,12 @@ from app.schemas.studies import (
 router = APIRouter(prefix="/studies", tags=["studies"])
 
 
-@router.post("/speed-sweep", operation_id="sweepSpeeds", summary="Best constant speed")
+@router.post(
+    "/speed-sweep",
+    operation_id="sweepSpeeds",
+    summary="Best constant speed",
+    response_model=SpeedSweepResponse,
+)
 async def sweep_speeds(
     request: Annotated[
         SpeedSweepRequest,
@@ -44,13 +50,19 @@ async def sweep_speeds(
     http: Request,
     settings: SettingsDep,
     pool: ExecutorDep,
-) -> SpeedSweepResponse:
+) -> Response:
     """Energy per km of each consumer on flat trips at each speed, and the speed with the
     lowest total: with the cooling unit on, about 40 km/h (paper Fig. 11)."""
-    return await pool.run(sweep, request, settings, disconnected=http.is_disconnected)
+    made = await pool.run(answered, sweep, request, settings, disconnected=http.is_disconnected)
+    return Response(made.body, media_type=made.media_type)
 
 
-@router.post("/scenarios", operation_id="runScenarios", summary="Seasons × drivers × traffic")
+@router.post(
+    "/scenarios",
+    operation_id="runScenarios",
+    summary="Seasons × drivers × traffic",
+    response_model=ScenariosResponse,
+)
 async def run_scenarios(
     request: Annotated[
         ScenariosRequest,
@@ -66,16 +78,18 @@ async def run_scenarios(
     http: Request,
     settings: SettingsDep,
     pool: ExecutorDep,
-) -> ScenariosResponse:
+) -> Response:
     """The round planned once for its own conditions (the baseline), then simulated on that
     tour for every combination of season, driver aggressiveness and traffic density."""
-    return await pool.run(scenarios, request, settings, disconnected=http.is_disconnected)
+    made = await pool.run(answered, scenarios, request, settings, disconnected=http.is_disconnected)
+    return Response(made.body, media_type=made.media_type)
 
 
 @router.post(
     "/electrification",
     operation_id="studyElectrification",
     summary="Which routes can go electric, with which battery",
+    response_model=ElectrificationResponse,
 )
 async def study_electrification(
     request: Annotated[
@@ -92,7 +106,7 @@ async def study_electrification(
     http: Request,
     settings: SettingsDep,
     pool: ExecutorDep,
-) -> ElectrificationResponse:
+) -> Response:
     """Each route as it was driven — its stops in order from its start time — simulated for
     each candidate van on every day it is driven in the year, with that date's weather: the
     days each battery covers (alone, and with the charges a day may take), the battery that
@@ -112,7 +126,10 @@ async def study_electrification(
         )
     )
     runtime_s = time.perf_counter() - started
-    return await asyncio.to_thread(merged_answer, request, settings, context, list(done), runtime_s)
+    made = await asyncio.to_thread(
+        answered, merged_answer, request, settings, context, list(done), runtime_s
+    )
+    return Response(made.body, media_type=made.media_type)
 
 
 @router.post(
