@@ -12,7 +12,7 @@ import numpy as np
 from core.params import PRESETS, Depot, RoadMatrix, Stop, TimeWindow, Weather
 from core.planning.day.scene import Scene, legs_for
 from core.planning.fleet.planner import check_fleet
-from core.planning.model import FleetProblem, FleetVehicle
+from core.planning.model import FleetProblem, FleetVehicle, default_work_s
 from core.planning.search.day import FleetDay, fleet_day
 
 VIENNA = ZoneInfo("Europe/Vienna")
@@ -51,6 +51,11 @@ def two_clusters(service_s: float = 300.0, **changes: Any) -> tuple[list[Stop], 
 
 
 def fleet(stops: list[Stop], vehicles: list[FleetVehicle], **fields: Any) -> FleetProblem:
+    """The fleet day of ``vehicles`` serving ``stops``. Without a time limit, the work a default
+    request of this size gets (a second's) and the time to do it on a busy machine: a search the
+    clock cut would give another answer."""
+    if "time_limit_s" not in fields:
+        fields = {"time_limit_s": 60.0, "work_s": default_work_s(1.0)} | fields
     return FleetProblem(
         date=DAY,
         timezone="Europe/Vienna",

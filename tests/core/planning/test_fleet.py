@@ -233,7 +233,7 @@ def test_a_fleet_of_one_plans_what_the_single_round_plans():
 
 def test_the_same_input_gives_the_same_plan():
     stops, matrix = two_clusters(time_windows=[window("09:00", "11:00")])
-    problem = fleet(stops, [van("a"), van("b")], matrix=matrix, time_limit_s=30)
+    problem = fleet(stops, [van("a"), van("b")], matrix=matrix, time_limit_s=30, work_s=3)
     first, second = plan_fleet(problem), plan_fleet(problem)
     assert first.runtime_s < 30  # ended before its limit
     assert [r.plan.tour for r in first.routes] == [r.plan.tour for r in second.routes]
@@ -269,7 +269,7 @@ def test_every_route_holds_in_its_simulation(seed):
         )
         for k in range(3)
     ]
-    problem = fleet(stops, vehicles, objective="energy", time_limit_s=3)
+    problem = fleet(stops, vehicles, objective="energy", time_limit_s=30, work_s=0.3)
     assert_holds(plan_fleet(problem), problem)
 
 

@@ -43,22 +43,25 @@ from tests.utils.fleets import van as cluster_van
 FAST = Charger(id="hpc-prater", lat=48.215, lon=16.40, power_kw=150, price_per_kwh=0.59)
 
 
-def fleet(problem, vans, time_limit_s=16.0, shift_end="21:00", **fields) -> FleetProblem:
+def fleet(problem, vans, work_s=1.6, shift_end="21:00", **fields) -> FleetProblem:
+    """The fleet of ``vans`` on ``problem``'s day with ``work_s`` of search and the time to do
+    it on a busy machine (a search the clock cut would give another answer)."""
     return FleetProblem(
         **fields_of(problem, RoundFields) | fields,
         vehicles=[
             FleetVehicle(id=f"van-{k}", shift_start="07:00", shift_end=shift_end, van=van)
             for k, van in enumerate(vans)
         ],
-        time_limit_s=time_limit_s,
+        time_limit_s=60 * work_s,
+        work_s=work_s,
     )
 
 
 @pytest.fixture(scope="module")
 def one_van():
     day = summer_day(None)
-    # the default work (5 s) tries the stops left out with charging 50 times
-    charged = fleet(day, [day.van], chargers=[FAST], time_limit_s=50)
+    # 5 s of work tries the stops left out with charging 50 times
+    charged = fleet(day, [day.van], chargers=[FAST], work_s=5)
     return plan_fleet(fleet(day, [day.van])), plan_fleet(charged)
 
 
@@ -88,7 +91,7 @@ def test_a_stop_charging_cannot_save_says_charging_was_tried():
     charging was tried (a dispatcher would otherwise add chargers in vain)."""
     day = summer_day(None)
     far = Charger(id="far-away", lat=49.47, lon=16.40, power_kw=150, price_per_kwh=0.59)
-    result = plan_fleet(fleet(day, [day.van], chargers=[far], time_limit_s=10))
+    result = plan_fleet(fleet(day, [day.van], chargers=[far], work_s=1))
     left = [u for u in result.unassigned if u.reason == "battery"]
     assert len(left) >= 10
     assert all("charging did not let a van serve it" in u.detail for u in left)
@@ -115,7 +118,7 @@ def two_clusters() -> FleetProblem:
     van = day.van.model_copy(update={"battery": BatteryParams(usable_capacity_kwh=10.0)})
     depot = Depot(id="depot", lat=48.21, lon=16.37, charger=ChargePoint(power_kw=22, points=1))
     base = day.model_copy(update={"stops": stops, "depot": depot})
-    return fleet(base, [van, van], time_limit_s=50, shift_end="14:00", minimize_vehicles=False)
+    return fleet(base, [van, van], work_s=5, shift_end="14:00", minimize_vehicles=False)
 
 
 def test_vans_at_a_one_point_charger_never_charge_at_once():
@@ -185,7 +188,8 @@ def test_a_stop_the_charging_verification_left_out_goes_to_an_idle_van(monkeypat
         [cluster_van("van-0", battery=small), cluster_van("van-1", end="08:30", battery=small)],
         matrix=matrix,
         minimize_vehicles=True,
-        time_limit_s=20,
+        time_limit_s=120,  # the work, not a busy machine's clock, ends the search
+        work_s=2,
     )
     result = plan_fleet(problem.model_copy(update={"depot": depot}))
     (stop,) = dropped

@@ -53,6 +53,7 @@ def summer_day(charger: ChargePoint | None, **battery: object) -> PlanProblem:
         weather=Weather(t_min_c=21, t_max_c=31),
         van=van,
         time_limit_s=30.0,  # the search ends long before: the same order on a loaded machine
+        work_s=3.0,
     )
 
 
