@@ -1,9 +1,11 @@
-"""Serving: a 60 s mixed load over HTTP, liveness while two 500-stop jobs run, and jobs per
-second through the server's own pool and through Celery with two workers (loopback only)."""
+"""Serving: a 60 s mixed load over HTTP, liveness while two 400-stop rounds are answered and
+while two 500-stop jobs run, and jobs per second through the server's own pool and through
+Celery with two workers (loopback only)."""
 
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import copy
 import random
 import time
@@ -13,6 +15,7 @@ import numpy as np
 
 from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
 from benchmarks.common import Server, celery_cluster, print_table, vienna_stops
+from tests.app.serving import long_plan
 
 LOAD_S = 60.0
 CLIENTS = 8
@@ -133,6 +136,51 @@ def liveness_under_jobs() -> None:
     )
 
 
+def _probed_while(url: str, bodies: list[dict]) -> np.ndarray:
+    """GET /healthz latencies [ms] from the moment ``bodies`` are posted to /v1/plans at once
+    until the last is answered (its parsing, solve and writing all inside)."""
+    latencies = []
+    with concurrent.futures.ThreadPoolExecutor(len(bodies)) as pool, httpx.Client() as http:
+        posted = [
+            pool.submit(httpx.post, f"{url}/v1/plans", json=body, timeout=120) for body in bodies
+        ]
+        while not all(f.done() for f in posted):
+            started = time.perf_counter()
+            http.get(f"{url}/healthz", timeout=10)
+            latencies.append(time.perf_counter() - started)
+            time.sleep(0.01)
+        assert all(f.result().status_code == 200 for f in posted)
+    return np.array(latencies) * 1000
+
+
+def liveness_under_rounds() -> None:
+    """The audit's case (issue #50): two 400-stop rounds posted at once to a fresh server, then
+    again; their answers (0.6 MB each) are written out in the workers."""
+    server = Server({"COLDROUTE_WORKERS": "2"}).start()
+    rows = []
+    try:
+        for when in ("first requests", "second requests"):
+            bodies = [long_plan(400, 3, seed=s) for s in (1, 2)]
+            ms = _probed_while(server.url, bodies)
+            rows.append(
+                [
+                    when,
+                    len(ms),
+                    f"{np.percentile(ms, 50):.1f}",
+                    f"{np.percentile(ms, 99):.1f}",
+                    f"{ms.max():.1f}",
+                ]
+            )
+    finally:
+        server.close()
+    print_table(
+        "GET /healthz while two 400-stop rounds are posted to /v1/plans at once (parsed, "
+        "solved, answered)",
+        ["server", "probes", "p50 [ms]", "p99 [ms]", "max [ms]"],
+        rows,
+    )
+
+
 def _throughput(url: str, n_jobs: int) -> tuple[float, int]:
     started = time.perf_counter()
     with httpx.Client(timeout=30) as http:
@@ -169,6 +217,7 @@ def jobs_per_second(n_jobs: int = 40) -> None:
 
 def main() -> None:
     mixed_load()
+    liveness_under_rounds()
     liveness_under_jobs()
     jobs_per_second()
 

@@ -317,9 +317,14 @@ def test_a_worker_killed_mid_job_runs_it_again(server):
     time.sleep(0.5)
     solving = busiest_child(server.process.pid)
     assert solving is not None, "no worker is solving"
+    killed_at = dt.datetime.now(dt.UTC)
     os.kill(solving, signal.SIGKILL)
     done = wait_for(server.url, job_id)
-    assert done["status"] == "succeeded" and done["attempts"] == 2
+    assert done["status"] == "succeeded"
+    assert dt.datetime.fromisoformat(done["started_at"]) > killed_at  # it ran again
+    # An attempt, unless Pebble had not yet heard that worker take it: on a busy machine the
+    # word may come late, and the pool then broke "before it ran" (no attempt counted).
+    assert done["attempts"] in (1, 2)
 
 
 def test_sigkill_and_restart_lose_no_job():
