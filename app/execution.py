@@ -35,8 +35,11 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
 from pebble import ProcessExpired, ProcessPool
+from pydantic import BaseModel
+from starlette.responses import Response
 
 from app.logs import configure_logging
+from app.operations.encoded import Encoded, answered
 from app.settings import Settings
 from core.arrays import keep_heap
 
@@ -111,6 +114,11 @@ def pool_broke(error: BaseException) -> bool:
 def ping() -> int:
     """A worker's process id: what a warm-up runs when it is given nothing to load."""
     return os.getpid()
+
+
+def sent(made: Encoded) -> Response:
+    """The response that sends an answer a worker wrote out: the event loop builds nothing."""
+    return Response(made.body, media_type=made.media_type)
 
 
 class WorkerPool:
@@ -239,6 +247,16 @@ class Executor:
             return await self._await(self._schedule(fn, args))
         finally:
             self._slots().release()
+
+    async def answer(
+        self,
+        make: Callable[..., BaseModel],
+        *args: Any,
+        disconnected: Callable[[], Awaitable[bool]] | None = None,
+    ) -> Response:
+        """``make(*args)``'s answer, built and written out in a worker (:meth:`run`): the
+        response that sends its bytes."""
+        return sent(await self.run(answered, make, *args, disconnected=disconnected))
 
     async def reserve(self, wait_s: float) -> bool:
         """Hold a free worker for a job, waiting at most ``wait_s`` [s] in line with the

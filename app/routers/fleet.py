@@ -8,6 +8,7 @@ from fastapi import APIRouter, Body, Request, Response
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import FLEET_EXAMPLES
+from app.execution import sent
 from app.openapi_doc import request_examples
 from app.operations.fleet_plan import fleet_answer
 from app.schemas.fleet import FleetPlanRequest, FleetPlanResponse
@@ -39,4 +40,4 @@ async def create_fleet_plan(
     are."""
     made = await pool.run(fleet_answer, request, settings, disconnected=http.is_disconnected)
     http.app.state.metrics.solve.observe(made.runtime_s)
-    return Response(made.body, media_type=made.media_type)
+    return sent(made)

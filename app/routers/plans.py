@@ -8,6 +8,7 @@ from fastapi import APIRouter, Body, Header, Request, Response
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import PLAN_EXAMPLES
+from app.execution import sent
 from app.openapi_doc import request_examples
 from app.operations.plan import GEOJSON, plan_answer
 from app.schemas.plans import PlanRequest, PlanResponse
@@ -72,4 +73,4 @@ async def create_plan(
         plan_answer, request, settings, wants_geojson(accept), disconnected=http.is_disconnected
     )
     http.app.state.metrics.solve.observe(made.runtime_s)
-    return Response(made.body, media_type=made.media_type)
+    return sent(made)

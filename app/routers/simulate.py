@@ -9,7 +9,6 @@ from fastapi import APIRouter, Body, Request, Response
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import SIMULATE_EXAMPLE, SIMULATE_TRACE_EXAMPLE
 from app.operations import simulate as operation
-from app.operations.encoded import answered
 from app.schemas.simulate import SimulateRequest, SimulateResponse
 
 router = APIRouter(tags=["simulation"])
@@ -43,7 +42,6 @@ async def simulate_trace(
 ) -> Response:
     """Per-consumer power and energy, state of charge and battery verdict along a trace you send
     (`speed_mps`, `dt_s`, `grade`) or one generated from a street type (`cycle`)."""
-    made = await pool.run(
-        answered, operation.simulate_trace, request, settings, disconnected=http.is_disconnected
+    return await pool.answer(
+        operation.simulate_trace, request, settings, disconnected=http.is_disconnected
     )
-    return Response(made.body, media_type=made.media_type)

@@ -11,6 +11,7 @@ from starlette.concurrency import run_in_threadpool
 
 from app.deps import ExecutorDep, SettingsDep
 from app.examples import ELECTRIFICATION_EXAMPLE, SCENARIOS_EXAMPLE, SPEED_SWEEP_EXAMPLE
+from app.execution import sent
 from app.operations.electrification import merged_answer, plan_study, run_study_part
 from app.operations.encoded import answered
 from app.operations.studies import run_scenarios as scenarios
@@ -53,8 +54,7 @@ async def sweep_speeds(
 ) -> Response:
     """Energy per km of each consumer on flat trips at each speed, and the speed with the
     lowest total: with the cooling unit on, about 40 km/h (paper Fig. 11)."""
-    made = await pool.run(answered, sweep, request, settings, disconnected=http.is_disconnected)
-    return Response(made.body, media_type=made.media_type)
+    return await pool.answer(sweep, request, settings, disconnected=http.is_disconnected)
 
 
 @router.post(
@@ -81,8 +81,7 @@ async def run_scenarios(
 ) -> Response:
     """The round planned once for its own conditions (the baseline), then simulated on that
     tour for every combination of season, driver aggressiveness and traffic density."""
-    made = await pool.run(answered, scenarios, request, settings, disconnected=http.is_disconnected)
-    return Response(made.body, media_type=made.media_type)
+    return await pool.answer(scenarios, request, settings, disconnected=http.is_disconnected)
 
 
 @router.post(
@@ -126,10 +125,11 @@ async def study_electrification(
         )
     )
     runtime_s = time.perf_counter() - started
-    made = await asyncio.to_thread(
-        answered, merged_answer, request, settings, context, list(done), runtime_s
+    return sent(
+        await asyncio.to_thread(
+            answered, merged_answer, request, settings, context, list(done), runtime_s
+        )
     )
-    return Response(made.body, media_type=made.media_type)
 
 
 @router.post(
