@@ -15,6 +15,7 @@ from app.connectors.osrm import OsrmRouter
 from app.examples import SCENARIOS_EXAMPLE
 from core.exceptions import NoRouteError
 from core.params import Place
+from core.planning.model import default_work_s
 from core.planning.search.day import leg_roads
 from tests.app.apps import app_client
 from tools import osrm
@@ -365,6 +366,9 @@ def test_a_fleet_on_real_roads_keeps_its_windows_as_driven(roads):
     body["vehicles"] = [
         {"id": f"van-{k}", "shift_start": "09:00", "shift_end": "12:00"} for k in range(3)
     ]
+    # a default request's work, and time to do it: a busy machine's clock (the router's calls
+    # inside) once cut the search before it placed a stop
+    body |= {"time_limit_s": 30, "work_s": default_work_s(1.0)}
     answer = roads.post("/v1/fleet-plans", json=body)
     assert answer.status_code == 200, answer.text
     fleet = answer.json()
