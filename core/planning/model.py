@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import datetime as dt
 import hashlib
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Annotated, Any, Literal
@@ -193,14 +194,16 @@ class SearchFields(Params):
     replay: Replay | None = Field(
         None,
         description="An earlier answer's solver.replay, to do its searches' work again to "
-        "the byte without the clock (sent with the same request; time_limit_s does not cap it).",
+        "the byte without the clock (sent with the same request; time_limit_s does not cap it). "
+        "A replay running longer than 3 times the server's cap on time_limit_s and 10 s is "
+        "refused (413, naming replay).",
     )
 
     def fingerprint(self) -> str:
         """SHA-256 of the problem as the search sees it: every field but ``replay`` and
         ``time_limit_s`` (which only caps the work) [hex] (0.2 s for 1,000 stops and their
         matrix)."""
-        text = self.model_dump_json(exclude={"replay", "time_limit_s"})
+        text = self.model_dump_json(exclude={"replay", "time_limit_s", "replay_limit_s"})
         return hashlib.sha256(text.encode()).hexdigest()
 
     def work(self, time_limit_s: float) -> float:
@@ -232,15 +235,21 @@ class SearchFields(Params):
         if len(set(watches)) != len(watches):
             raise InvalidParameterError("replay.stops names a watch twice", "replay.stops")
 
-    def effort(self, time_limit_s: float) -> Effort:
+    def effort(self, time_limit_s: float, replay_limit_s: float | None = None) -> Effort:
         """The search's effort from now: its work (:meth:`work`), capped ``time_limit_s`` from
-        now, with the seed; replaying, stopped where the replay says instead. Its clock knows
-        the request's fingerprint (:func:`replay_of`)."""
+        now, with the seed; replaying, stopped where the replay says instead, and refused
+        beyond ``replay_limit_s`` [s] from now (None: never). Its clock knows the request's
+        fingerprint (:func:`replay_of`)."""
         fingerprint = self.fingerprint()
         self.check_replay(time_limit_s, fingerprint)
         replayed = None if self.replay is None else {s.watch: s.at for s in self.replay.stops}
         return Effort.starting_now(
-            self.work(time_limit_s), time_limit_s, self.seed, replayed, fingerprint
+            self.work(time_limit_s),
+            time_limit_s,
+            self.seed,
+            replayed,
+            fingerprint,
+            math.inf if replay_limit_s is None else replay_limit_s,
         )
 
 
@@ -448,7 +457,18 @@ class PlanFields(RoundFields, TripFields, StartFields, SearchFields):
     breaks: Breaks = breaks_field("none")
 
 
-class PlanProblem(PlanFields):
+class ServedFields(Params):
+    """What the server adds to a problem it was sent."""
+
+    replay_limit_s: float | None = Field(
+        None,
+        gt=0,
+        description="The most a replay's searches may take [s] (a replay's work is not capped "
+        "by time_limit_s): beyond it the replay is refused, naming replay. None: no limit.",
+    )
+
+
+class PlanProblem(PlanFields, ServedFields):
     """Everything a round needs: its fields and the van."""
 
     van: VanParams = Field(default_factory=VanParams, description="The van.")
@@ -526,7 +546,7 @@ def vehicles_field() -> list[FleetVehicle]:
     )
 
 
-class FleetProblem(FleetFields):
+class FleetProblem(FleetFields, ServedFields):
     """The day's stops and the fleet that serves them from one depot."""
 
     vehicles: list[FleetVehicle] = vehicles_field()

@@ -42,6 +42,8 @@ from typing import Literal
 
 import numpy as np
 
+from core.exceptions import ServerLimitError
+
 #: How a search ended: its work done, its optimum proven, or cut short by the deadline.
 SearchEnd = Literal["work", "proof", "time_limit"]
 
@@ -77,6 +79,11 @@ class Clock:
     request: str = ""
     stops: dict[int, int] = field(default_factory=dict)
     made: int = 0
+    #: Replaying: when (a ``time.perf_counter`` value) the replay has run too long, and the
+    #: time it had [s] — a replay's work is not capped by its request's clock, so this is
+    #: what stops a replay whose work no answer of the server did.
+    guard: float = math.inf
+    guard_s: float = math.inf
 
     @property
     def replaying(self) -> bool:
@@ -86,6 +93,18 @@ class Clock:
         """The next watch, on ``deadline`` (a ``time.perf_counter`` value)."""
         self.made += 1
         return Watch(self, self.made - 1, deadline)
+
+    def guarded(self, cut: bool = False) -> None:
+        """Replaying: raise :class:`core.exceptions.ServerLimitError` naming ``replay`` once
+        the replay has run past its guard, or when a solver's own time limit (the guard's)
+        ``cut`` it — either way its answer would not be the replayed one."""
+        if cut or time.perf_counter() > self.guard:
+            raise ServerLimitError(
+                f"this replay's searches ran for more than the {self.guard_s:g} s this server "
+                "gives a replay: its work (replay.work_s, replay.stops) is more than an answer "
+                "of this server did — send an answer's solver.replay unchanged",
+                "replay",
+            )
 
 
 @dataclass
@@ -101,6 +120,7 @@ class Watch:
         """Whether the search stops after ``count`` units (counts never go back): at the
         deadline, recorded; replaying, where the record says."""
         if self.clock.replayed is not None:
+            self.clock.guarded()
             at = self.clock.replayed.get(self.index)
             return at is not None and count >= at
         if self.index in self.clock.stops:
@@ -112,9 +132,12 @@ class Watch:
 
     def mark(self, count: int) -> None:
         """Record that the clock stopped the search after ``count`` units, where the search
-        saw it itself (a solver's own time limit)."""
+        saw it itself (a solver's own time limit); replaying, that limit is the guard's
+        (:meth:`Clock.guarded`)."""
         if self.clock.replayed is None:
             self.clock.stops.setdefault(self.index, count)
+        else:
+            self.clock.guarded(cut=True)
 
     def replayed_at(self) -> int | None:
         """Replaying: the count after which the record stops the search (None: it ran its
@@ -142,11 +165,14 @@ class Effort:
         seed: int = 0,
         replayed: dict[int, int] | None = None,
         request: str = "",
+        replay_limit_s: float = math.inf,
     ) -> Effort:
         """``work_s`` of work, capped ``time_limit_s`` from now; ``replayed``: where the
         deadline stopped the same work of the same ``request`` before (:class:`Clock`), the
-        clock then unread."""
-        return cls(work_s, time.perf_counter() + time_limit_s, seed, Clock(replayed, request))
+        clock then unread but for the replay's own limit, ``replay_limit_s`` from now."""
+        now = time.perf_counter()
+        clock = Clock(replayed, request, guard=now + replay_limit_s, guard_s=replay_limit_s)
+        return cls(work_s, now + time_limit_s, seed, clock)
 
     def watch(self) -> Watch:
         """A new look at this effort's deadline."""
@@ -165,10 +191,11 @@ class Effort:
         return replace(self, deadline=self.deadline - reserve_s)
 
     def left_s(self) -> float:
-        """Time to the deadline [s]; replaying, without end (its watches stop the searches):
-        for solvers' own time limits and reserves, never to decide whether to stop."""
+        """Time to the deadline [s]; replaying, to the replay's guard (its watches stop the
+        searches): for solvers' own time limits and reserves, never to decide whether to
+        stop."""
         if self.clock.replaying:
-            return math.inf
+            return self.clock.guard - time.perf_counter()
         return self.deadline - time.perf_counter()
 
     def kicks(self, places: int) -> int:

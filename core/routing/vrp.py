@@ -578,7 +578,7 @@ def _ortools_routes(
         found[0] = 0
         solution = routing.SolveWithParameters(params)
     # fewer solutions than its limit, and (near enough) all its time: its time limit cut it
-    if replayed is None and found[0] < limit and time.perf_counter() - started >= budget_s * 0.9:
+    if found[0] < params.solution_limit and time.perf_counter() - started >= budget_s * 0.9:
         watch.mark(found[0])
     ended: SearchEnd = "time_limit" if watch.passed(found[0]) else "work"
     if solution is None:

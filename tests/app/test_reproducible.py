@@ -23,6 +23,7 @@ from app.main import app
 from app.openapi_doc import RESPONSE_EXAMPLES
 from benchmarks.common import Server, busy_core
 from core.planning.model import default_work_s
+from tests.app.apps import app_client
 from tests.app.test_jobs import submit, wait_for
 
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "integrators" / "rounds.md"
@@ -208,3 +209,22 @@ def test_a_replay_of_another_request_is_refused_naming_it(client_default, change
     refused = client_default.post("/v1/plans", json=body | {"replay": forged})
     assert refused.status_code == 422
     assert [e["field"] for e in refused.json()["errors"]] == ["replay.seed"]
+
+
+def test_a_replay_of_work_no_answer_did_is_refused_at_the_servers_replay_limit():
+    """A replay is not stopped by the clock: one whose work is beyond the server's cap and whose
+    stops are emptied would search unbounded; the server refuses it after 3 times its cap and
+    10 s (here 10.03 s), naming replay — while the answer's own replay is answered. (A round's
+    search may end on a proof first; its engines' refusals are tested in the core.)"""
+    client = app_client(max_time_limit_s=0.01)
+    path = "/v1/fleet-plans"
+    body = without_replay(dict(examples(path))["vienna-two-vans"]) | {"work_s": 600}
+    first = client.post(path, json=body).json()
+    replay = first["solver"]["replay"]
+    assert replay["work_s"] == 600 and replay["stops"]  # cut at once by the 0.01 s cap
+    again = client.post(path, json=body | {"replay": replay})
+    assert again.status_code == 200 and without_timing(again.json()) == without_timing(first)
+    unbounded = client.post(path, json=body | {"replay": replay | {"stops": []}})
+    assert unbounded.status_code == 413, unbounded.text
+    assert [e["field"] for e in unbounded.json()["errors"]] == ["replay"]
+    assert "10.03 s this server gives a replay" in unbounded.json()["detail"]

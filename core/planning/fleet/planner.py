@@ -124,7 +124,7 @@ def plan_fleet(
         An hourly forecast for the day, as in :func:`core.planning.round.planner.plan`.
     """
     started = time.perf_counter()
-    effort = problem.effort(problem.time_limit_s)
+    effort = problem.effort(problem.time_limit_s, problem.replay_limit_s)
     shifts, timezone_name = check_fleet(problem)
     scene, starts, weather_warnings = _fleet_scene(
         problem, shifts, timezone_name, router, weather_service

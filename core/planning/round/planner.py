@@ -82,7 +82,7 @@ def plan(
         so.
     """
     started = time.perf_counter()
-    effort = problem.effort(problem.time_limit_s)
+    effort = problem.effort(problem.time_limit_s, problem.replay_limit_s)
     start, timezone_name = check(problem)
     problem = under_way(problem)
     places = round_places(problem)

@@ -14,6 +14,7 @@ from ortools.sat.python import cp_model
 
 from benchmarks.common import euc_2d_matrix
 from benchmarks.evrptw import read
+from core.exceptions import ServerLimitError
 from core.routing.effort import Clock, Effort
 from core.routing.evrp import solve_evrptw
 from core.routing.tsp import _solve_exact, solve_tour
@@ -47,8 +48,7 @@ def test_a_replayed_watch_stops_where_the_record_says_and_ignores_the_clock():
     assert not first.passed(10**6)  # no record: it ran its work, whatever the clock
     assert [second.passed(k) for k in (3, 4, 5)] == [False, True, True]
     assert (first.replayed_at(), second.replayed_at()) == (None, 4)
-    second.mark(1)  # a replay records nothing
-    assert clock.stops == {}
+    assert clock.stops == {}  # a replay records nothing
     assert Effort.starting_now(1.0, -1.0, 0, {}).left_s() == math.inf
 
 
@@ -127,3 +127,20 @@ def test_the_charging_search_cut_by_the_clock_is_replayed_to_the_node(reference_
     first = solve_evrptw(instance, effort)
     assert first.ended == "time_limit" and effort.clock.stops
     assert solve_evrptw(instance, replay_of(effort)) == first
+
+
+def test_a_replay_past_its_limit_is_refused_naming_replay():
+    """A replay's watches do not read the deadline, but its limit: past it, at a watch or where
+    a solver's own time limit (the replay limit's) cut it, the replay is refused."""
+    clock = Clock(replayed={}, guard=time.perf_counter() - 1, guard_s=5.0)
+    with pytest.raises(ServerLimitError, match="more than the 5 s") as refused:
+        clock.watch(math.inf).passed(0)
+    assert refused.value.field == "replay"
+    unlimited = Clock(replayed={}, guard=math.inf).watch(-1.0)
+    assert not unlimited.passed(10**9)
+    with pytest.raises(ServerLimitError):  # a solver's own limit cut a replay
+        unlimited.mark(3)
+    within = Effort.starting_now(1000.0, -1.0, 1, {}, "", replay_limit_s=0.3)
+    assert 0 < within.left_s() <= 0.3  # what the solvers' own limits get
+    with pytest.raises(ServerLimitError):
+        _ortools_routes(vrptw(60), within, None)
