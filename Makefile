@@ -8,7 +8,7 @@ OSRM := .router/osrm/bin/osrm-routed
 PBF ?=
 ROUTER_DIR ?= .router/region
 
-.PHONY: test bench serve worker openapi report lint clean router router-serve wheelhouse image \
+.PHONY: test check bench serve worker openapi report lint clean router router-serve wheelhouse image \
 	test-image docs
 
 $(STAMP): pyproject.toml
@@ -44,7 +44,12 @@ $(GUIDE): $(STAMP) mkdocs.yml openapi/openapi.json $(shell find docs -type f)
 
 docs: $(GUIDE)
 
-test: lint $(GUIDE) $(OSRM) $(CHROMIUM)
+# The fast tier (a few minutes): every test but those marked slow — servers started, full
+# searches, outside services; `make check` runs everything (what CI runs).
+test: lint $(GUIDE) $(OSRM)
+	$(BIN)/python -m pytest -n 2 --dist worksteal -m "not slow"
+
+check: lint $(GUIDE) $(OSRM) $(CHROMIUM)
 	$(BIN)/python -m pytest -n 2 --dist worksteal
 
 BENCH_STAMP := $(VENV)/.bench-installed

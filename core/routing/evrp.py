@@ -630,7 +630,13 @@ class _Search(_Solution):
         order = sorted(range(len(self.routes)), key=lambda r: len(self.routes[r][1]))
         _, out = self.routes.pop(order[nth % len(order)])
         self.priced.penalty = LATE_PENALTY
-        if not all(self.insert(c, allow_new=False) for c in self._customers(out)):
+        # a long route's customers into long routes take seconds: the deadline is looked at
+        # before each (counted: the customers put in so far)
+        inserting = effort.watch()
+        if not all(
+            not inserting.passed(k) and self.insert(c, allow_new=False)
+            for k, c in enumerate(self._customers(out))
+        ):
             (self.routes, self.left), self.priced.penalty = saved, math.inf
             return False
         watch = effort.watch()
