@@ -61,3 +61,23 @@ def weather_stub() -> Iterator[StubServer]:
     server = StubServer()
     yield server
     server.shutdown()
+
+
+#: Fixtures that start a server or an outside service: a test that uses one is in the slow tier.
+SERVER_FIXTURES = frozenset({"server", "server_url", "services", "broker", "osrm_url", "page"})
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Refuse a test that starts a server but is not marked ``slow``: ``make test`` (the fast
+    tier) leaves those to ``make check``, and one left out of the mark would slow it again."""
+    unmarked = [
+        item.nodeid
+        for item in items
+        if SERVER_FIXTURES.intersection(getattr(item, "fixturenames", ()))
+        and item.get_closest_marker("slow") is None
+    ]
+    if unmarked:
+        raise pytest.UsageError(
+            "these tests start a server but are not marked slow (pytest.mark.slow): "
+            + ", ".join(unmarked)
+        )

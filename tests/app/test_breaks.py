@@ -9,6 +9,7 @@ from app.examples import CHARGING_PLAN_EXAMPLE, FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
 LUNCH = {"earliest": "12:00", "latest": "13:00", "minutes": 30}
 
 
+@pytest.mark.slow
 def test_a_round_with_a_lunch_break_answers_it_in_the_timeline(client):
     body = CHARGING_PLAN_EXAMPLE | {"breaks": [LUNCH], "battery": {"usable_capacity_kwh": 120}}
     response = client.post("/v1/plans", json=body)

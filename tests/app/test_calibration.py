@@ -22,6 +22,7 @@ def client():
     return app_client(max_body_bytes=2_000_000, max_sync_calibration_samples=5000)
 
 
+@pytest.mark.slow
 def test_the_example_recovers_the_van_that_logged_it(client):
     response = client.post("/v1/calibrations", json=CALIBRATION_EXAMPLE)
     assert response.status_code == 200, response.text
@@ -118,6 +119,7 @@ def test_an_unknown_parameter_is_named(client):
     assert any(e["field"].startswith("parameters[1]") for e in response.json()["errors"])
 
 
+@pytest.mark.slow
 def test_too_many_samples_for_an_answer_is_a_413_pointing_to_jobs_which_fit_them():
     server = Server(
         {"COLDROUTE_WORKERS": "2", "COLDROUTE_MAX_SYNC_CALIBRATION_SAMPLES": "1000"}

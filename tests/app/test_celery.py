@@ -32,6 +32,9 @@ from tests.app.test_jobs import (
 from tests.app.test_reproducible import without_timing
 from tests.router_stub import DownRouter
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 POSTGRES = "postgresql://postgres@127.0.0.1:5432/test"
 REDIS_DB = 11
 

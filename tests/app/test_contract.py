@@ -10,7 +10,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from benchmarks.common import Server
+
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
 
 KEY = "contract-key"
 #: ``st``, with room on the stack: Hypothesis describes its lambdas by parsing their source

@@ -8,6 +8,9 @@ import pytest
 from app.examples import PLAN_EXAMPLE
 from benchmarks.common import running_server
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def server_url():

@@ -12,6 +12,9 @@ import pytest
 from app.examples import ELECTRIFICATION_EXAMPLE
 from tests.app.apps import app_client
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 PATH = "/v1/studies/electrification"
 
 

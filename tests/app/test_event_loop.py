@@ -68,6 +68,7 @@ def test_an_answer_is_written_as_fastapi_writes_a_response_model():
         assert encoded(answer).body == TypeAdapter(model).dump_json(answer, by_alias=True)
 
 
+@pytest.mark.slow
 def test_the_contract_is_read_at_start_up_not_by_the_first_request(tmp_path):
     app = create_app(Settings(database_url=f"sqlite:///{tmp_path}/jobs.db", workers=1))
 

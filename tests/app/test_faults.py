@@ -38,6 +38,9 @@ from tests.app.test_jobs import (
 )
 from tests.utils.tcp_proxy import TcpProxy
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 #: How long PostgreSQL is away in the outage test [s]: longer than Celery's default retries.
 DATABASE_OUTAGE_S = 30
 #: Loopback only, and nothing kept on disk.

@@ -152,6 +152,7 @@ def test_a_fleet_that_serves_no_stop_says_so(client):
     assert answer["solver"]["status"] == "no_solution"
 
 
+@pytest.mark.slow
 def test_more_vans_than_the_server_plans_is_a_413_naming_vehicles():
     body = copy.deepcopy(FLEET_PLAN_EXAMPLE)
     small = app_client(max_vehicles=1)

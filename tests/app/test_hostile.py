@@ -337,6 +337,7 @@ def test_settings_bind_loopback_unless_told(monkeypatch):
     assert Settings().host == "0.0.0.0"
 
 
+@pytest.mark.slow
 def test_the_real_server_writes_one_json_line_per_request():
     server = Server({"COLDROUTE_LOG_LEVEL": "info", "COLDROUTE_WORKERS": "1"}).start()
     try:

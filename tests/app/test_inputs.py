@@ -120,6 +120,7 @@ def test_the_folders_are_many_and_include_the_audits():
 
 
 @pytest.mark.parametrize("path", DAY_BODIES)
+@pytest.mark.slow
 def test_a_name_that_is_not_a_zone_is_a_422_naming_the_timezone(client, path):
     prefix = DAY_BODIES[path][1]
     for name in NOT_ZONES:
@@ -271,6 +272,7 @@ def van_section(section: str, name: str, value: float) -> dict[str, Any]:
 
 
 @pytest.mark.parametrize(("section", "name", "minimum"), BOUNDED)
+@pytest.mark.slow
 def test_below_a_physical_minimum_is_a_422_on_every_endpoint(client, section, name, minimum):
     for value in [*SUBNORMALS, minimum * 0.999]:
         part = van_section(section, name, value)
@@ -360,6 +362,7 @@ def matrix_plan(distance_m: float, duration_s: float, n_stops: int = 3) -> dict[
         (1e5, 1000, None),
     ],
 )
+@pytest.mark.slow
 def test_a_leg_faster_than_any_van_keeps_its_distance_and_says_so(
     client, distance_m, duration_s, accel_mps2
 ):
@@ -382,6 +385,7 @@ def test_a_leg_faster_than_any_van_keeps_its_distance_and_says_so(
         assert leg["duration_s"] >= duration_s
 
 
+@pytest.mark.slow
 def test_a_fleet_on_a_matrix_faster_than_any_van_keeps_its_distances(client):
     body = FLEET_PLAN_EXAMPLE | {
         "stops": PLAN_EXAMPLE["stops"][:3],
@@ -516,6 +520,7 @@ def test_a_study_that_would_run_for_minutes_is_a_413_pointing_to_jobs(client):
     client.delete(f"/v1/jobs/{job.json()['id']}")
 
 
+@pytest.mark.slow
 def test_a_sweep_that_would_run_for_minutes_is_a_413_pointing_to_jobs(client):
     # With the default bound (a year of driving) a sweep within its other limits fits; a server
     # told to answer at most a day synchronously refuses eleven 20 km trips at 1 km/h.

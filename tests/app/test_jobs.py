@@ -31,6 +31,9 @@ from tests.app.serving import (
 )
 from tests.router_stub import DownRouter
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 FAST = {
     "COLDROUTE_WORKERS": "2",
     "COLDROUTE_JOB_SLOTS": "1",

@@ -182,6 +182,7 @@ def test_the_day_profile_is_the_simulation_minute_by_minute(client):
     assert client.post("/v1/plans", json=PLAN_EXAMPLE).json()["profile"] is None
 
 
+@pytest.mark.slow
 def test_a_stop_far_from_the_depot_is_planned_with_a_warning_naming_it(client):
     from app.examples import FLEET_PLAN_EXAMPLE
     from tests.app.apps import app_client

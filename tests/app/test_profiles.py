@@ -22,6 +22,9 @@ from core.params import PRESETS
 from tests.app.test_celery import own_services
 from tests.app.test_jobs import submit, wait_for
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 #: The reefer preset as one fleet runs it: heavier, a bigger pack, a better box.
 CHANGES = {
     "vehicle": {"mass_kg": 3100.0, "drag_coefficient": 0.36},

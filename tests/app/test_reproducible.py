@@ -26,6 +26,9 @@ from core.planning.model import default_work_s
 from tests.app.apps import app_client
 from tests.app.test_jobs import submit, wait_for
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "integrators" / "rounds.md"
 #: The answer's fields that report timing: they differ between runs.
 TIMING = ("runtime_s",)

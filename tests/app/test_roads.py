@@ -20,6 +20,9 @@ from core.planning.search.day import leg_roads
 from tests.app.apps import app_client
 from tools import osrm
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 PLACES = {
     "moneghetti": (43.7380, 7.4148),
     "casino": (43.7397, 7.4274),

@@ -17,6 +17,9 @@ from app.execution import WorkerPool, ping, pool_broke
 from benchmarks.common import Server
 from tests.app.serving import alive, children, heap_kept_after_churn_bytes, long_plan
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture
 def server(request):

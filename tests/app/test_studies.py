@@ -72,6 +72,7 @@ def test_report_writes_page_and_charts(tmp_path):
         assert f"({name}.png)" in text
 
 
+@pytest.mark.slow
 def test_report_cli_runs(tmp_path):
     run = subprocess.run(
         [sys.executable, "-m", "report.paper", "--out", str(tmp_path), "--quick"],
@@ -82,6 +83,7 @@ def test_report_cli_runs(tmp_path):
     assert run.returncode == 0 and "wrote" in run.stdout
 
 
+@pytest.mark.slow
 def test_a_grid_of_week_long_rounds_is_refused_before_it_runs(client):
     """The audit: 1,200 cells of a 5.8-day round passed the limit, which counted cell-stops
     only. The services alone (7 stops of 20 h) make each cell at least 5.8 days: the study

@@ -25,6 +25,9 @@ from tests.app.test_browser import offline_tab
 from tests.app.test_jobs import BIG_STUDY
 from tests.app.test_roads import monaco_plan
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts" / "viewer"
 #: The server wants an API key: the page sends what its field holds.
 KEY = "dispatch-key"

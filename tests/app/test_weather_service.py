@@ -13,6 +13,9 @@ from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
 from tests.app.apps import app_client
 from tools.osrm import free_port
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 # Forecasts are for days to come; the archive answers for days gone.
 TOMORROW = (dt.datetime.now(dt.UTC).date() + dt.timedelta(days=1)).isoformat()
 ROUND = {k: v for k, v in PLAN_EXAMPLE.items() if k != "weather"} | {

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import re
 
+import pytest
+
 from app.errors import PROBLEMS
 from app.main import app
 from app.settings import Settings
@@ -52,6 +54,7 @@ def test_the_settings_tables_defaults_are_the_codes():
     assert compared >= 20  # the table's plain defaults were read
 
 
+@pytest.mark.slow
 def test_every_endpoint_is_in_the_endpoint_table_and_every_one_listed_exists():
     listed = set(re.findall(r"^\| (GET|POST|PUT|DELETE) \| `([^`]+)` \|", ENDPOINTS, re.M))
     operations = {

@@ -28,6 +28,9 @@ from tests.docs.examples import (
     same_output,
 )
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 #: Pages whose files are run through the plan viewer (tests/docs/test_site.py), not a request.
 VIEWER_PAGES = {"docs/dispatchers/viewer.md"}
 PAGES = [p for p in pages() if any(b.is_request or b.language == "python" for b in blocks(p))]

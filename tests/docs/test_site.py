@@ -16,6 +16,9 @@ from benchmarks.common import Server
 from tests.app.test_browser import offline_tab
 from tests.docs.examples import ROOT, blocks
 
+#: Starts servers or outside services, or runs full searches: make check, not make test.
+pytestmark = pytest.mark.slow
+
 VIEWER_GUIDE = ROOT / "docs" / "dispatchers" / "viewer.md"
 
 

@@ -317,6 +317,7 @@ def noisy_trips(van: VanParams, seed: int, seconds: int = 600) -> list[MeasuredT
     return trips
 
 
+@pytest.mark.slow
 def test_the_95_percent_intervals_cover_the_truth_under_telematics_noise():
     """The trust issue: with noise that grows with the power, the Gauss–Newton intervals
     excluded the true drag and rolling resistance (5 of 40 missed where 2 would be nominal;

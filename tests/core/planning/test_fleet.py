@@ -231,6 +231,7 @@ def test_a_fleet_of_one_plans_what_the_single_round_plans():
     assert route.energy_kwh == pytest.approx(single.energy_kwh)
 
 
+@pytest.mark.slow
 def test_the_same_input_gives_the_same_plan():
     stops, matrix = two_clusters(time_windows=[window("09:00", "11:00")])
     problem = fleet(stops, [van("a"), van("b")], matrix=matrix, time_limit_s=30, work_s=3)

@@ -65,6 +65,7 @@ def one_van():
     return plan_fleet(fleet(day, [day.van])), plan_fleet(charged)
 
 
+@pytest.mark.slow
 def test_the_stops_a_battery_left_out_are_served_with_a_charger(one_van):
     without, charged = one_van
     left = [u for u in without.unassigned if u.reason == "battery"]
@@ -121,6 +122,7 @@ def two_clusters() -> FleetProblem:
     return fleet(base, [van, van], work_s=5, shift_end="14:00", minimize_vehicles=False)
 
 
+@pytest.mark.slow
 def test_vans_at_a_one_point_charger_never_charge_at_once():
     result = plan_fleet(two_clusters())
     plug = dt.timedelta(minutes=2)  # the default plug_minutes

@@ -23,6 +23,7 @@ def distance_units(name: str, budget_s: float, minimize: bool) -> tuple[float, i
 
 
 @pytest.mark.parametrize("name", ["RC208", "C101"])
+@pytest.mark.slow
 def test_solomon_distance_is_on_par_with_pyvrp(name):
     # ../shared/reference/vrptw/: the bar is 2 % on any instance at the same budget
     theirs, _ = pyvrp_solomon(solomon(name), 4.0, minimize_vehicles=False)
@@ -31,6 +32,7 @@ def test_solomon_distance_is_on_par_with_pyvrp(name):
     assert ours <= theirs * 1.02
 
 
+@pytest.mark.slow
 def test_minimize_vehicles_uses_no_more_vans_than_pyvrp_with_a_fixed_cost_per_van():
     # R201: the best known is 4 vans (README of vrptw/); PyVRP with a large fixed cost per van
     theirs, their_vans = pyvrp_solomon(solomon("R201"), 4.0, minimize_vehicles=True)
@@ -48,6 +50,7 @@ def short_shifts(problem: FleetProblem) -> FleetProblem:
     return problem.model_copy(update={"vehicles": vans})
 
 
+@pytest.mark.slow
 def test_more_vans_never_serve_fewer_stops():
     few = plan_fleet(short_shifts(vienna_grid(150, 2, 4.0)))
     many = plan_fleet(short_shifts(vienna_grid(150, 40, 4.0)))

@@ -191,6 +191,7 @@ def windowed_day(charger: ChargePoint | None) -> PlanProblem:
     return day.model_copy(update={"stops": stops, "time_limit_s": 5.0})
 
 
+@pytest.mark.slow
 def test_a_round_with_time_windows_charges_where_its_windows_leave_time():
     """The order is the fleet search's (the windows first); the charges go where the forward
     slack allows them, and no window is missed."""

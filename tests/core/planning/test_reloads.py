@@ -69,6 +69,7 @@ def test_what_the_trips_cannot_carry_is_refused_naming_the_field():
     assert caught.value.field == "stops[39].delivery_kg"
 
 
+@pytest.mark.slow
 def test_a_round_with_time_windows_comes_back_to_reload():
     """Windows and reloads together (they were a 422): the fleet search with this one van
     places the returns; the windowed stop is served inside its window, no trip carries more

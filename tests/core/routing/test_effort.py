@@ -121,6 +121,7 @@ def test_ortools_cut_by_its_own_limit_is_replayed_to_the_node(limit_s):
     assert _ortools_routes(problem, replay_of(effort), None) == first
 
 
+@pytest.mark.slow
 def test_the_charging_search_cut_by_the_clock_is_replayed_to_the_node(reference_dir):
     instance = read(reference_dir / "evrptw" / "rc101_21.txt").problem
     effort = cut(60.0, 2.0)

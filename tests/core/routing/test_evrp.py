@@ -301,6 +301,7 @@ def test_the_independent_check_names_what_a_route_breaks():
     assert check(inst, [[(0, 0.0), (2, 10.0), (1, 0.0), (2, 20.0), (0, 0.0)]]) is None
 
 
+@pytest.mark.slow
 def test_the_benchmark_command_answers_one_checked_json_line_per_instance():
     path = FOLDER / "c101_21.txt"
     done = subprocess.run(
@@ -331,6 +332,7 @@ def test_the_benchmark_command_answers_one_checked_json_line_per_instance():
 
 
 @pytest.mark.parametrize("pinned", [1, 3, 5])
+@pytest.mark.slow
 def test_a_customer_pinned_to_a_kind_is_served_by_it_and_the_rest_by_the_others(pinned):
     """The small instance with one more vehicle of a second kind, alike but the only one
     that may serve ``pinned`` (the first kind forbids it): every customer served, ``pinned``

@@ -146,6 +146,7 @@ def proven_optimum(cost: np.ndarray) -> int:
     ],
     ids=lambda case: case.name,
 )
+@pytest.mark.slow
 def test_clustered_rounds_reach_the_optimum_the_nearest_neighbours_miss(case):
     # Three to five clusters and the depot away from them: the optimum over each place's
     # nearest neighbours is longer than the true one, because the arcs between the clusters
