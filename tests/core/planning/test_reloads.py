@@ -12,7 +12,7 @@ import pytest
 from core.exceptions import InvalidParameterError, InvalidStopsError
 from core.params import ChargePoint, TimeWindow
 from core.planning.fleet.planner import plan_fleet
-from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
+from core.planning.model import FleetProblem, FleetVehicle, RoundFields, default_work_s, fields_of
 from core.planning.round.planner import plan
 from tests.core.planning.test_recharge import summer_day
 
@@ -119,7 +119,14 @@ def fleet_of_trips(max_trips: int, charger=None, capacity_kwh: float = 40.0) -> 
         reload_minutes=20,
         van=van,
     )
-    return FleetProblem(**fields_of(day, RoundFields) | {"stops": stops}, vehicles=[vehicle])
+    # a default request's work (30 stops: a 1.8 s limit) with the time to do it: a busy
+    # machine's clock once cut it into another day, its charge no longer at the reload
+    return FleetProblem(
+        **fields_of(day, RoundFields) | {"stops": stops},
+        vehicles=[vehicle],
+        time_limit_s=60,
+        work_s=default_work_s(1.8),
+    )
 
 
 def trip_loads(result) -> list[float]:
