@@ -80,7 +80,7 @@ MIN_BATTERY_MARGIN = 0.85
 #: battery), the first's share of the work, and how many times what a route fell below its
 #: reserve its kind of van's battery is made smaller after.
 CHARGING_ROUNDS = 3
-FIRST_SHARE = 0.7
+FIRST_SHARE = 0.85
 TIGHTEN_MARGIN = 1.2
 #: And at least this share of the battery: a route that ends a rounding below its reserve
 #: would otherwise send the search back to the same routes. Likewise a route back after its

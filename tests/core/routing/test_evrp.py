@@ -19,7 +19,7 @@ import pytest
 
 from benchmarks.evrptw import FOLDER, check, read
 from core.routing.effort import Effort
-from core.routing.evrp import EvrpInstance, VehicleKind, _Priced, solve_evrptw
+from core.routing.evrp import EvrpInstance, VehicleKind, _Priced, _Search, solve_evrptw
 from core.routing.stations import NO_ROUTE
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -350,3 +350,26 @@ def test_a_customer_pinned_to_a_kind_is_served_by_it_and_the_rest_by_the_others(
     assert check(with_pin, routes) is None
     priced = _Priced(with_pin)
     assert priced.charged(0, [pinned]) is NO_ROUTE and priced.charged(1, [pinned]) is not NO_ROUTE
+
+
+def test_a_route_is_emptied_by_taking_out_a_customer_that_fits_elsewhere():
+    """An ejection pool (Nagata & Bräysy 2009) at work, by hand: three vehicles of 3 on a
+    line, unit speed. East: 1 and 2 (no window) and 6 (due at 16, so only a route that goes
+    east first reaches it); west: 4 and 5 (due at 12 and 14); north: 3 (no window). Routes
+    [1, 2, 3], [4, 5], [6]: 6 fits in neither of the others (the east route is full, the west
+    one cannot reach it in time), but put in the east route in place of 3, with 3 in the west
+    route, two vehicles serve all six."""
+    xy = [(0, 0), (10, 0), (12, 0), (0, 10), (-10, 0), (-12, 0), (14, 0)]
+    due = np.array([1000.0, 1000, 1000, 1000, 12, 14, 16])
+    inst = instance(xy, "dcccccc", due=due, capacity=3.0, battery=1000.0)
+    search = _Search(inst, np.random.default_rng(0))
+    search.start([(0, [1, 2, 3]), (0, [4, 5]), (0, [6])])
+    assert len(search.routes) == 3
+    saved = search._saved()
+    search.routes.pop()
+    assert not search.insert(6, allow_new=False)  # nowhere without taking one out
+    search.routes, search.left = saved
+    assert search._eliminate(math.inf, 0, Effort(1.0, math.inf))
+    routes = sorted(sorted(route) for _, route in search.routes)
+    assert routes == [[1, 2, 6], [3, 4, 5]]
+    assert search.holds() and search.left == []
