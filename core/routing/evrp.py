@@ -84,8 +84,8 @@ MEMO_SIZE = 1_000_000
 #: Emptying a route into the others: the share of the work left one attempt may take, and
 #: the most of the search's work all attempts may take together (a fleet that cannot lose a
 #: vehicle leaves the rest to the cost). From 0.1 and 0.2 (and lateness penalised instead of
-#: an ejection pool) to these: E-VRPTW r1 and rc1 at a 60 s request's work from 1.13 vans
-#: over the best known on average to 0.53.
+#: an ejection pool) to these: E-VRPTW r1 at a 60 s request's work from 1.22 vans over the
+#: best known on average to 0.78 (docs/benchmarks.md).
 ELIMINATION_SHARE = 0.25
 ELIMINATION_BUDGET = 0.5
 #: Ruin-and-recreate moves on the cost between two attempts to empty a route; the most a
