@@ -22,11 +22,14 @@ never uses less energy than the instance's, so what the product plans holds ther
 from __future__ import annotations
 
 import itertools
+import json
 import math
 import os
 import re
+import tempfile
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import httpx
@@ -46,6 +49,8 @@ DAY_END_MIN = 1439
 KG_PER_UNIT = 0.1
 #: Vans offered on every instance (more than any best known uses).
 VANS_OFFERED = 25
+#: Where an answer that breaks the instance's rules is kept with its request.
+KEPT = Path(tempfile.gettempdir()) / "coldroute-bench-evrptw"
 #: Slack of the replay on times and energy (the windows are whole minutes).
 TOLERANCE = 1e-6
 #: The van whose energy is linear in distance (module docstring).
@@ -258,9 +263,15 @@ def evrptw_tables(budget_s: float = BUDGET_S) -> None:
         for instance in instances:
             day = scaled(instance, kwh_per_km)
             started = time.perf_counter()
-            answer = plan(fleet_request(day, budget_s))
+            body = fleet_request(day, budget_s)
+            answer = plan(body)
             wall_s = time.perf_counter() - started
             distance, broken = replay(day, answer)
+            if broken is not None:  # kept, to be explained: the request and its answer
+                kept = KEPT / f"{instance.name}.json"
+                kept.parent.mkdir(parents=True, exist_ok=True)
+                kept.write_text(json.dumps({"request": body, "answer": answer, "broken": broken}))
+                broken = f"{broken} (kept in {kept})"
             vans, best = known[instance.name]
             served = sum(len(route["stops"]) for route in answer["routes"])
             customers = len(instance.problem.customers)
