@@ -19,7 +19,7 @@ $(STAMP): pyproject.toml
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/ruff format --check core app tests benchmarks tools report image_tests
+	$(BIN)/ruff format --check core app tests testbed benchmarks tools report image_tests
 	$(BIN)/mypy core app report
 	$(BIN)/lint-imports
 

@@ -9,11 +9,12 @@ import time
 
 import numpy as np
 
-from benchmarks.common import REFERENCE, print_table
+from benchmarks.common import print_table
 from core.calibration.fit import CHANNELS, FitParameter, MeasuredTrip, calibrate
 from core.params import PRESETS, Location, VanParams, Weather
 from core.physics.cycles import load_cycle_csv
 from core.physics.simulate import simulate
+from testbed.reference import REFERENCE
 
 TRIPS = 10
 NOISE_W = 300.0

@@ -18,10 +18,11 @@ from typing import Any
 import httpx
 import numpy as np
 
-from benchmarks.common import Server, celery_cluster, children, print_table, rss_mib
+from benchmarks.common import print_table
 from core.params import PRESETS, Depot, Stop
 from core.planning.electrification.model import DrivenRoute
 from core.routing.geo import DETOUR_FACTOR
+from testbed.services import Server, celery_cluster, children, rss_mib
 
 DEPOT = Depot(id="depot", lat=48.17, lon=16.42)
 BATTERIES_KWH = (40.0, 60.0, 80.0)

@@ -7,12 +7,13 @@ from zoneinfo import ZoneInfo
 
 import numpy as np
 
-from benchmarks.common import REFERENCE, best_time_s, print_table
+from benchmarks.common import best_time_s, print_table
 from core.arrays import keep_heap
 from core.params import PRESETS, STREET_TYPES, DoorOpening, Interval, Location, Weather
 from core.physics.cycles import generate_leg, load_cycle_csv
 from core.physics.simulate import simulate
 from core.physics.weather import HourlyWeather
+from testbed.reference import REFERENCE
 
 START = dt.datetime(2026, 7, 15, 8, tzinfo=ZoneInfo("Europe/Vienna"))
 VIENNA = Location(lat=48.21, lon=16.37)

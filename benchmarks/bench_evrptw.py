@@ -35,8 +35,10 @@ from typing import Any
 import httpx
 import numpy as np
 
-from benchmarks.common import Server, print_table, vienna_stops
-from benchmarks.evrptw import FOLDER, Instance, best_known, read
+from benchmarks.common import print_table
+from testbed.evrptw import FOLDER, Instance, best_known, read
+from testbed.reference import vienna_stops
+from testbed.services import Server
 
 #: The time limit of each plan [s] (``COLDROUTE_BENCH_EVRPTW_S`` shortens it).
 BUDGET_S = float(os.environ.get("COLDROUTE_BENCH_EVRPTW_S", "60"))

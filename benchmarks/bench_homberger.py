@@ -25,7 +25,9 @@ from typing import Any
 import httpx
 import numpy as np
 
-from benchmarks.common import REFERENCE, Server, print_table, pyvrp_vrptw
+from benchmarks.common import print_table
+from testbed.reference import REFERENCE, pyvrp_vrptw
+from testbed.services import Server
 
 INSTANCES = ("C1_10_1", "R1_10_1", "RC1_10_1", "C2_10_1", "R2_10_1", "RC2_10_1")
 #: One distance unit [m]: at 0.75 min per time unit, 40 km/h, and the shortest arcs (1 unit)

@@ -17,10 +17,11 @@ from typing import Any
 import httpx
 import numpy as np
 
-from benchmarks.bench_fleet import solomon
 from benchmarks.bench_homberger import Instance, fleet_request, homberger
-from benchmarks.common import Server, print_table
+from benchmarks.common import print_table
 from core.planning.model import FLEET_TIME_LIMIT
+from testbed.fleets import solomon
+from testbed.services import Server
 
 #: Solomon's vans: 25, as the literature allows.
 SOLOMON_VANS = 25

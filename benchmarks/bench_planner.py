@@ -11,13 +11,15 @@ import time
 import elkai
 import numpy as np
 
-from benchmarks.common import REFERENCE, busy_core, euc_2d_matrix, print_table
+from benchmarks.common import print_table
 from core.params import Depot, Stop
 from core.planning.model import PLAN_TIME_LIMIT, PlanProblem, default_work_s
 from core.planning.round.planner import plan
 from core.routing.effort import Effort
 from core.routing.tsp import solve_tour, tour_cost
-from tests.utils.rounds import Round, clustered_round, uniform_round
+from testbed.reference import REFERENCE, euc_2d_matrix
+from testbed.rounds import Round, clustered_round, uniform_round
+from testbed.services import busy_core
 
 
 def delivery_rounds() -> list[Round]:

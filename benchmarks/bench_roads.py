@@ -13,11 +13,12 @@ import httpx
 import numpy as np
 
 from app.connectors.osrm import OsrmRouter
-from benchmarks.common import REFERENCE, print_table
+from benchmarks.common import print_table
 from core.params import Depot, RoadMatrix, Stop, Weather
 from core.planning.model import PlanProblem
 from core.planning.round.planner import plan
 from core.routing.roads import LegRoute, RoadTable
+from testbed.reference import REFERENCE
 from tools import osrm
 
 DEPOT = Depot(id="depot-fontvieille", lat=43.7290, lon=7.4180)

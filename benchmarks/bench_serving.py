@@ -14,8 +14,10 @@ import httpx
 import numpy as np
 
 from app.examples import PLAN_EXAMPLE, SIMULATE_EXAMPLE
-from benchmarks.common import Server, celery_cluster, print_table, vienna_stops
-from tests.app.serving import long_plan
+from benchmarks.common import print_table
+from testbed.reference import vienna_stops
+from testbed.services import Server, celery_cluster
+from testbed.serving import long_plan
 
 LOAD_S = 60.0
 CLIENTS = 8

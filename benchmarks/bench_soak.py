@@ -23,7 +23,8 @@ from app.examples import (
     SIMULATE_EXAMPLE,
 )
 from benchmarks.bench_serving import plan_with
-from benchmarks.common import Server, children, print_table, rss_mib
+from benchmarks.common import print_table
+from testbed.services import Server, children, rss_mib
 
 SOAK_S = float(os.environ.get("COLDROUTE_BENCH_SOAK_S", "3600"))
 CLIENTS = 4

@@ -13,7 +13,7 @@ import httpx
 import pytest
 from playwright.sync_api import Page, sync_playwright
 
-from benchmarks.common import Server
+from testbed.services import Server
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.
 pytestmark = pytest.mark.slow

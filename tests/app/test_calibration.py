@@ -13,7 +13,7 @@ import httpx
 import pytest
 
 from app.examples import CALIBRATION_EXAMPLE
-from benchmarks.common import Server
+from testbed.services import Server
 from tests.app.apps import app_client
 
 

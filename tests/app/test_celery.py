@@ -19,8 +19,8 @@ import pytest
 import redis
 
 from app.examples import CHARGING_PLAN_EXAMPLE, PLAN_EXAMPLE
-from benchmarks.common import Server
-from tests.app.serving import children, cpu_ticks, long_plan
+from testbed.services import Server, children
+from testbed.serving import cpu_ticks, long_plan
 from tests.app.test_jobs import (
     BIG_STUDY,
     assert_spaced,

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks.common import Server
+from testbed.services import Server
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.
 pytestmark = pytest.mark.slow

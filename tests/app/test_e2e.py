@@ -6,7 +6,7 @@ import httpx
 import pytest
 
 from app.examples import PLAN_EXAMPLE
-from benchmarks.common import running_server
+from testbed.services import running_server
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.
 pytestmark = pytest.mark.slow

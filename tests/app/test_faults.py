@@ -25,8 +25,8 @@ from app.jobs.celery_app import celery_for, visibility_timeout_s
 from app.jobs.lifecycle import JOB_EXTRA_TIME_S
 from app.jobs.store import JobStore
 from app.settings import Settings
-from benchmarks.common import POSTGRES, Server, children
-from tests.app.serving import alive, long_plan
+from testbed.services import POSTGRES, Server, children
+from testbed.serving import alive, long_plan
 from tests.app.test_celery import Worker, own_services
 from tests.app.test_jobs import (
     BIG_STUDY,

@@ -22,7 +22,7 @@ from app.logs import JsonLines
 from app.main import app as default_app
 from app.main import create_app
 from app.settings import Settings
-from benchmarks.common import Server
+from testbed.services import Server
 from tests.app.invariants import CheckedClient
 
 PROBLEM = "application/problem+json"

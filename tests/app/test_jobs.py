@@ -20,15 +20,8 @@ from app.examples import (
     PLAN_EXAMPLE,
     SCENARIOS_EXAMPLE,
 )
-from benchmarks.common import Server
-from tests.app.serving import (
-    alive,
-    big_fleet,
-    busiest_child,
-    children,
-    long_plan,
-    wait_quiet,
-)
+from testbed.services import Server, children
+from testbed.serving import alive, big_fleet, busiest_child, long_plan, wait_quiet
 from tests.router_stub import DownRouter
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.

@@ -17,8 +17,8 @@ from app.examples import (
     SPEED_SWEEP_EXAMPLE,
 )
 from app.profiles import ProfileStore
-from benchmarks.common import Server
 from core.params import PRESETS
+from testbed.services import Server
 from tests.app.test_celery import own_services
 from tests.app.test_jobs import submit, wait_for
 

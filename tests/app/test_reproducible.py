@@ -21,8 +21,8 @@ from app.examples import describe
 from app.execution import WORKER_NICENESS
 from app.main import app
 from app.openapi_doc import RESPONSE_EXAMPLES
-from benchmarks.common import Server, busy_core
 from core.planning.model import default_work_s
+from testbed.services import Server, busy_core
 from tests.app.apps import app_client
 from tests.app.test_jobs import submit, wait_for
 

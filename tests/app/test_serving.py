@@ -14,8 +14,8 @@ import pytest
 from pebble import ProcessPool
 
 from app.execution import WorkerPool, ping, pool_broke
-from benchmarks.common import Server
-from tests.app.serving import alive, children, heap_kept_after_churn_bytes, long_plan
+from testbed.services import Server, children
+from testbed.serving import alive, heap_kept_after_churn_bytes, long_plan
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.
 pytestmark = pytest.mark.slow

@@ -19,7 +19,7 @@ from pydantic import ValidationError
 
 from app.main import create_app
 from app.settings import Settings
-from benchmarks.common import Server
+from testbed.services import Server
 from tests.app.invariants import CheckedClient
 from tests.app.test_browser import offline_tab
 from tests.app.test_jobs import BIG_STUDY

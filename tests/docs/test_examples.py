@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from app.settings import Settings
-from benchmarks.common import Server
+from testbed.services import Server
 from tests.docs.examples import (
     ROOT,
     SERVICE,

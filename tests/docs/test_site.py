@@ -12,7 +12,7 @@ from collections.abc import Iterator
 import pytest
 from playwright.sync_api import expect
 
-from benchmarks.common import Server
+from testbed.services import Server
 from tests.app.test_browser import offline_tab
 from tests.docs.examples import ROOT, blocks
 

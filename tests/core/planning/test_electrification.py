@@ -33,7 +33,7 @@ from core.planning.electrification.study import (
 )
 from core.planning.model import PlanProblem
 from core.planning.round.planner import plan
-from tests.app.serving import vienna_stops
+from testbed.reference import vienna_stops
 
 DEPOT = Depot(id="depot", lat=48.21, lon=16.37)
 VAN = PRESETS["ev-van-3.5t-reefer"].van()

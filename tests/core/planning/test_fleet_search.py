@@ -7,9 +7,9 @@ from collections import Counter
 
 import pytest
 
-from benchmarks.bench_fleet import pyvrp_solomon, solomon, solomon_problem, vienna_grid
 from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem
+from testbed.fleets import pyvrp_solomon, solomon, solomon_problem, vienna_grid
 
 
 def distance_units(name: str, budget_s: float, minimize: bool) -> tuple[float, int, int]:

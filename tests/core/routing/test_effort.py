@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 from ortools.sat.python import cp_model
 
-from benchmarks.common import euc_2d_matrix
-from benchmarks.evrptw import read
 from core.exceptions import ServerLimitError
 from core.routing.effort import Clock, Effort
 from core.routing.evrp import solve_evrptw
 from core.routing.tsp import _solve_exact, solve_tour
 from core.routing.vrp import RoutingInput, VehicleSpec, _ortools_routes, _pyvrp_routes
+from testbed.evrptw import read
+from testbed.reference import euc_2d_matrix
 
 
 def cut(work_s: float, time_limit_s: float) -> Effort:

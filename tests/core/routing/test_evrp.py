@@ -1,7 +1,7 @@
 """Routing with recharging stations (core/routing/evrp.py): a route on a line whose charges
 and times are worked by hand, a window that charging makes unreachable, the lateness a
 penalty counts, a small instance against every split and order, and the benchmark command on
-a shared instance, its answer checked by the rules alone (benchmarks/evrptw.py)."""
+a shared instance, its answer checked by the rules alone (testbed/evrptw.py)."""
 
 from __future__ import annotations
 
@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.evrptw import FOLDER, check, read
 from core.routing.effort import Effort
 from core.routing.evrp import EvrpInstance, VehicleKind, _Priced, _Search, solve_evrptw
 from core.routing.stations import NO_ROUTE
+from testbed.evrptw import FOLDER, check, read
 
 ROOT = Path(__file__).resolve().parents[3]
 

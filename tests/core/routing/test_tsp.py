@@ -3,11 +3,11 @@ import itertools
 import numpy as np
 import pytest
 
-from benchmarks.common import euc_2d_matrix
 from core.routing.effort import Effort
 from core.routing.ils import _local_search_all, neighbours
 from core.routing.tsp import _first_tour, _solve_exact, solve_tour, tour_cost
-from tests.utils.rounds import clustered_round
+from testbed.reference import euc_2d_matrix
+from testbed.rounds import clustered_round
 
 
 def work(work_s: float = 0.4, time_limit_s: float = 60.0, seed: int = 0) -> Effort:
@@ -72,7 +72,7 @@ def test_same_input_same_tour():
 def test_the_same_work_gives_the_same_tour_however_busy_the_machine(reference_dir):
     """Stopped by its work (kicks), not by the clock: the same tour with a second search
     keeping the other core busy; another seed may give another."""
-    from benchmarks.common import busy_core
+    from testbed.services import busy_core
 
     cost = euc_2d_matrix(reference_dir / "tsplib" / "kroA200.tsp")
     idle = solve_tour(cost, work(0.3))

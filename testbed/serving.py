@@ -1,4 +1,5 @@
-"""Helpers of the serving tests: real servers in subprocesses, long rounds, worker processes."""
+"""Serving under load, for its tests and benchmarks: long rounds, big fleets, worker processes
+and what they use of the CPU and the heap."""
 
 from __future__ import annotations
 
@@ -12,7 +13,8 @@ from typing import Any
 import numpy as np
 
 from app.examples import FLEET_PLAN_EXAMPLE, PLAN_EXAMPLE
-from benchmarks.common import children, vienna_stops
+from testbed.reference import vienna_stops
+from testbed.services import children
 
 
 def long_plan(n_stops: int, time_limit_s: float, seed: int = 1) -> dict[str, Any]:
