@@ -7,7 +7,9 @@ request goes.
 
 An instance as a day (``../shared/reference/homberger/README.md``): every time scaled by
 1,439 / horizon into minutes (windows rounded inwards to whole minutes, as a client sends
-them), one distance unit :data:`UNIT_M` metres, the instance's distances and scaled times sent as
+them), one distance unit what a van drives in a time unit at :data:`SPEED_KMH` (type 2's long
+horizons make a unit a fifth of a minute: a fixed length of unit had vans at 150 km/h, which
+the simulation of the drive rightly refused), the instance's distances and scaled times sent as
 the matrix; vans of the instance's capacity with batteries that never bind, no breaks, the
 distance the objective. PyVRP solves the same rounded instance (distances in hundredths).
 """
@@ -30,9 +32,9 @@ from testbed.reference import REFERENCE, pyvrp_vrptw
 from testbed.services import Server
 
 INSTANCES = ("C1_10_1", "R1_10_1", "RC1_10_1", "C2_10_1", "R2_10_1", "RC2_10_1")
-#: One distance unit [m]: at 0.75 min per time unit, 40 km/h, and the shortest arcs (1 unit)
-#: can be driven from rest to rest in their time.
-UNIT_M = 500.0
+#: The speed of every arc [km/h]: the shortest arcs (1 unit) can be driven from rest to rest
+#: in their time.
+SPEED_KMH = 40.0
 #: PyVRP works on integers: distances and times in hundredths of a unit.
 PYVRP_SCALE = 100
 #: The time limit both are given [s] (``COLDROUTE_BENCH_HOMBERGER_S`` shortens it).
@@ -54,6 +56,11 @@ class Instance:
     capacity: int
     vans: int
     best: tuple[int, float]  # best known vans and distance
+
+    @property
+    def unit_m(self) -> float:
+        """One distance unit [m]: a time unit's drive at :data:`SPEED_KMH`."""
+        return SPEED_KMH / 60.0 * self.minutes_per_unit * 1000.0
 
     @property
     def distance(self) -> np.ndarray:
@@ -135,8 +142,8 @@ def fleet_request(instance: Instance, time_limit_s: float) -> dict[str, Any]:
         "stops": [
             {
                 "id": f"c{k}",
-                "lat": 48.0 + (instance.xy[k, 1] - instance.xy[0, 1]) * UNIT_M / 111_000,
-                "lon": 16.0 + (instance.xy[k, 0] - instance.xy[0, 0]) * UNIT_M / 74_000,
+                "lat": 48.0 + (instance.xy[k, 1] - instance.xy[0, 1]) * instance.unit_m / 111_000,
+                "lon": 16.0 + (instance.xy[k, 0] - instance.xy[0, 0]) * instance.unit_m / 74_000,
                 "delivery_kg": float(instance.demand[k]),
                 "service_time_s": instance.service_min * 60.0,
                 "door_open_s": 60.0,
@@ -146,7 +153,7 @@ def fleet_request(instance: Instance, time_limit_s: float) -> dict[str, Any]:
             if k
         ],
         "matrix": {
-            "distances_m": np.round(distance * UNIT_M, 1).tolist(),
+            "distances_m": np.round(distance * instance.unit_m, 1).tolist(),
             "durations_s": np.round(distance * unit_s, 1).tolist(),
         },
         "weather": {"t_min_c": 8, "t_max_c": 18},
@@ -207,7 +214,7 @@ def ours(server: Server, instance: Instance, budget_s: float) -> dict[str, Any]:
     answer = response.json()
     served = sum(len(route["stops"]) for route in answer["routes"])
     return {
-        "distance": answer["totals"]["distance_m"] / UNIT_M,
+        "distance": answer["totals"]["distance_m"] / instance.unit_m,
         "vans": answer["totals"]["vehicles_used"],
         "served": served,
         "wall_s": wall_s,
