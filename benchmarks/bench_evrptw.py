@@ -7,16 +7,19 @@ best known, and summed up by class (c1, c2, r1, r2, rc1, rc2); and the Vienna da
 same fleet without chargers and with batteries that never bind.
 
 An instance as a day: one distance unit is ``s`` km and one time unit ``s`` minutes (60 km/h),
-``s`` = min(1, the day's minutes / the horizon); windows rounded inwards to whole minutes; the
-instance's distances and times sent as the client's matrix, the stations' rows after the stops
-(each station a charger of many points, no plug-in time). The van's energy is linear in
-distance: no drag worth the name, every braking recovered, no standing loads (the box at the
-ambient temperature, no cab air-conditioning, no auxiliaries), a flat charging curve; its energy
-per km ``e`` is measured on the product, its battery holds the instance's range (Q / r units of
-distance) at ``e``, and its chargers' power makes the product's charge time per energy the
-instance's ``g``. The replay drives each answer's tour by the instance's rules (energy r ×
-distance, charge time g × energy, a charge never beyond a full battery): a van of the product
-never uses less energy than the instance's, so what the product plans holds there.
+``s`` = min(1, the day's minutes / the horizon); windows rounded inwards to whole minutes, but a
+minute wide at least (:func:`day_window`); the instance's distances and times sent as the
+client's matrix, the stations' rows after the stops (each station a charger of many points, no
+plug-in time). The van's energy is linear in distance: no drag worth the name, every braking
+recovered, no standing loads (the box at the ambient temperature, no cab air-conditioning, no
+auxiliaries), a flat charging curve; its energy per km ``e`` is measured on the product, its
+battery holds the instance's range (Q / r units of distance) at ``e``, and its chargers' power
+makes the product's charge time per energy the instance's ``g``. The replay drives each answer's
+tour by the instance's rules (energy r × distance, charge time g × energy, a charge never beyond
+a full battery): a van of the product never uses less energy than the instance's, so what the
+product plans holds there — but at a window open for an instant (C87 and C100 of r110, r111,
+r209, r210, rc205 and rc207: ready = due), which no window of whole minutes is: the day gives it
+a minute, and the replay holds the van to that minute there.
 """
 
 from __future__ import annotations
@@ -111,6 +114,15 @@ def scaled(instance: Instance, kwh_per_km: float) -> Scaled:
     return Scaled(instance, unit, kwh_per_km * unit)
 
 
+def day_window(day: Scaled, k: int) -> tuple[int, int]:
+    """Place ``k``'s window in the day's minutes: rounded inwards to whole minutes, but a
+    minute wide at least (some windows of the set are open for an instant)."""
+    problem = day.instance.problem
+    a, b = problem.ready[k] * day.unit, problem.due[k] * day.unit
+    opens = math.ceil(a - 1e-9)
+    return opens, max(min(math.floor(b + 1e-9), DAY_END_MIN), opens + 1)
+
+
 def fleet_request(day: Scaled, time_limit_s: float) -> dict[str, Any]:
     """The instance as the JSON body of ``POST /v1/fleet-plans`` (module docstring)."""
     problem, ids, xy = day.instance.problem, day.instance.ids, day.instance.xy
@@ -130,13 +142,6 @@ def fleet_request(day: Scaled, time_limit_s: float) -> dict[str, Any]:
         dx, dy = (xy[k] - xy[0]) * day.unit * 1000.0
         return {"lat": 48.0 + dy / 111_000, "lon": 16.0 + dx / 74_000}
 
-    def window(k: int) -> tuple[int, int]:
-        """Rounded inwards to whole minutes, but a minute wide at least (some windows of
-        the set are narrower than a minute once scaled)."""
-        a, b = problem.ready[k] * day.unit, problem.due[k] * day.unit
-        opens = math.ceil(a - 1e-9)
-        return opens, max(min(math.floor(b + 1e-9), DAY_END_MIN), opens + 1)
-
     return {
         "date": "2026-04-15",
         "timezone": "UTC",
@@ -148,7 +153,7 @@ def fleet_request(day: Scaled, time_limit_s: float) -> dict[str, Any]:
                 "battery": battery,
                 "payload_kg": day.kind.capacity * KG_PER_UNIT,
                 "shift_start": "00:00",
-                "shift_end": clock(window(0)[1]),
+                "shift_end": clock(day_window(day, 0)[1]),
                 "breaks": "none",
             }
             for k in range(VANS_OFFERED)
@@ -160,7 +165,9 @@ def fleet_request(day: Scaled, time_limit_s: float) -> dict[str, Any]:
                 "delivery_kg": float(problem.demand[k]) * KG_PER_UNIT,
                 "service_time_s": float(problem.service[k]) * day.unit * 60.0,
                 "door_open_s": 0.0,
-                "time_windows": [{"start": clock(window(k)[0]), "end": clock(window(k)[1])}],
+                "time_windows": [
+                    {"start": clock(day_window(day, k)[0]), "end": clock(day_window(day, k)[1])}
+                ],
             }
             for k in problem.customers
         ],
@@ -195,7 +202,9 @@ def replay(day: Scaled, answer: dict[str, Any]) -> tuple[float, str | None]:
             clock_u += problem.duration[place, j]
             if battery < -TOLERANCE * kind.battery:
                 return total, f"{route['vehicle_id']} runs empty before {name}"
-            if clock_u > problem.due[j] + TOLERANCE:
+            # a window the day widened to a minute closes at the minute's end
+            due = max(problem.due[j], day_window(day, j)[1] / day.unit)
+            if clock_u > due + TOLERANCE:
                 return total, f"{route['vehicle_id']} reaches {name} after its window"
             clock_u = max(clock_u, problem.ready[j]) + problem.service[j]
             if j in problem.stations:
