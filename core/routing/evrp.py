@@ -28,9 +28,11 @@ may not serve (pinned to others).
    customer that fits nowhere goes in by taking out the customer of that route that failed
    least often, which goes back into the pool; a ruin-and-recreate move after each; undone
    when the attempt's work runs out) — and the cost: ruin and recreate (a few nearby
-   customers out, each back where it costs least, only into routes that hold one of its
-   :data:`NEIGHBOURS` nearest; the customers left out tried again), kept when no worse (a
-   route it empties is a vehicle less too). Last, the routes polished: a stretch turned round
+   customers out, or strings of consecutive customers out of nearby routes as in SISR,
+   Christiaens & Vanden Berghe 2020; each back where it costs least in one of SISR's orders,
+   only into routes that hold one of its :data:`NEIGHBOURS` nearest; the customers left out
+   tried again), kept when at most a falling threshold worse (a route it empties is a
+   vehicle less too). Last, the routes polished: a stretch turned round
    (2-opt), two routes' ends exchanged (2-opt*), while that is cheaper. The
    :data:`SEARCHED_STARTS` best starts are each searched so, the better kept.
 """
@@ -74,8 +76,16 @@ SQUARE_S = 2.4e-7
 MOVE_S = 1e-4
 #: PyVRP's integers: costs and times this many per unit.
 _SCALE = 1000
-#: Customers taken out and put back by one ruin-and-recreate move.
+#: Customers taken out and put back by one ruin-and-recreate move: at most (nearest to a
+#: customer), or strings of consecutive customers out of nearby routes (:data:`STRING_SHARE` of
+#: the moves; on average :data:`STRING_MEAN` out, strings at most :data:`STRING_MOST` long).
 RUIN_SIZE = 14
+STRING_SHARE = 0.5
+STRING_MEAN = 10
+STRING_MOST = 10
+#: How often the customers go back at random, the largest demand first, the farthest from the
+#: depot first, the nearest first (SISR's weights 4, 4, 2, 1).
+RECREATE_ORDERS = (4 / 11, 4 / 11, 2 / 11, 1 / 11)
 #: A customer is inserted only into routes that hold one of its this many nearest customers
 #: (a granular neighbourhood, Toth & Vigo 2003).
 NEIGHBOURS = 15
@@ -691,15 +701,16 @@ class _Search(_Solution):
         self.moves += 1
         saved = self._saved()
         before = self.total()
-        customers = self.instance.customers
-        seed = int(self.rng.integers(len(customers)))
-        size = int(self.rng.integers(2, RUIN_SIZE + 1))
-        taken = {customers[k] for k in self.nearest[seed][:size]} - set(self.left) - set(out)
+        seed = int(self.rng.integers(len(self.instance.customers)))
+        if self.rng.random() < STRING_SHARE:
+            taken = self._strings(seed)
+        else:
+            size = int(self.rng.integers(2, RUIN_SIZE + 1))
+            taken = {self.instance.customers[k] for k in self.nearest[seed][:size]}
+        taken -= set(self.left) | set(out)
         self.routes = [(k, [c for c in r if c not in taken]) for k, r in self.routes]
         self.routes = [(k, r) for k, r in self.routes if self._customers(r)]
-        placed = all(
-            self.insert(int(c), allow_new=new_routes) for c in self.rng.permutation(sorted(taken))
-        )
+        placed = all(self.insert(c, allow_new=new_routes) for c in self._recreate_order(taken))
         if new_routes:
             self.left = [c for c in self.left if not self.insert(c)]
         after = self.total()
@@ -708,6 +719,53 @@ class _Search(_Solution):
         )
         if not placed or worse or not self.holds():
             self.routes, self.left = saved
+
+    def _strings(self, seed: int) -> set[int]:
+        """Strings of customers out of routes near the ``seed``-th customer (Christiaens &
+        Vanden Berghe 2020, SISR): the routes of its nearest customers in turn, from each a
+        string of consecutive customers through that customer, until the drawn number of
+        routes is ruined; :data:`STRING_MEAN` customers out on average, strings at most
+        :data:`STRING_MOST` long (or the routes' mean length)."""
+        routes = [self._customers(r) for _, r in self.routes]
+        where = {c: r for r, route in enumerate(routes) for c in route}
+        if not routes:
+            return set()
+        longest = min(STRING_MOST, sum(map(len, routes)) / len(routes))
+        most_strings = 4.0 * STRING_MEAN / (1.0 + longest) - 1.0
+        strings = int(self.rng.uniform(1.0, most_strings + 1.0))
+        taken: set[int] = set()
+        ruined: set[int] = set()
+        for k in self.nearest[seed]:
+            if len(ruined) >= strings:
+                break
+            r = where.get(self.instance.customers[k])
+            if r is None or r in ruined:
+                continue
+            route = routes[r]
+            length = int(self.rng.integers(1, int(min(len(route), longest)) + 1))
+            at = route.index(self.instance.customers[k])
+            first = int(
+                self.rng.integers(max(at - length + 1, 0), min(at, len(route) - length) + 1)
+            )
+            taken.update(route[first : first + length])
+            ruined.add(r)
+        return taken
+
+    def _recreate_order(self, taken: set[int]) -> list[int]:
+        """The order the customers ``taken`` go back in (SISR's): at random, the largest
+        demand first, the farthest from the depot first or the nearest first, drawn
+        :data:`RECREATE_ORDERS`."""
+        inst = self.instance
+        shuffled = [int(c) for c in self.rng.permutation(sorted(taken))]
+        how = self.rng.choice(len(RECREATE_ORDERS), p=RECREATE_ORDERS)
+        keys = (
+            None,
+            lambda c: -inst.demand[c],
+            lambda c: -inst.distance[0, c],
+            lambda c: inst.distance[0, c],
+        )
+        key = keys[how]
+        return shuffled if key is None else sorted(shuffled, key=key)
 
     def restore_best(self) -> None:
         """The best routes seen, on the routes' own cost (no lateness)."""

@@ -373,3 +373,57 @@ def test_a_route_is_emptied_by_taking_out_a_customer_that_fits_elsewhere():
     routes = sorted(sorted(route) for _, route in search.routes)
     assert routes == [[1, 2, 6], [3, 4, 5]]
     assert search.holds() and search.left == []
+
+
+def test_a_string_ruin_takes_one_run_of_consecutive_customers_from_each_route_it_ruins():
+    """SISR's string removal (Christiaens & Vanden Berghe 2020), by its definition: four
+    routes of ten customers, each along its own row (mean length 10, so strings of at most
+    :data:`STRING_MOST` and at most 4·10/(1 + 10) − 1 = 2.6, i.e. 3, routes ruined); from each
+    ruined route one run of consecutive customers, the seed's own route among them; about
+    :data:`STRING_MEAN` customers out on average."""
+    from core.routing.evrp import STRING_MEAN, STRING_MOST
+
+    xy = [(0.0, -10.0)] + [(float(x), float(10 * row)) for row in range(4) for x in range(10)]
+    inst = instance(xy, "d" + "c" * 40, capacity=100.0, battery=1e6)
+    routes = [list(range(1 + 10 * row, 11 + 10 * row)) for row in range(4)]
+    most_routes = math.floor(4 * STRING_MEAN / (1 + min(STRING_MOST, 10)) - 1 + 1)
+    sizes = []
+    search = _Search(inst, np.random.default_rng(0))
+    search.routes = [(0, list(r)) for r in routes]
+    for seed in range(1000):
+        customer = seed % 40
+        taken = search._strings(customer)
+        ruined = [r for r in routes if taken.intersection(r)]
+        assert 1 <= len(ruined) <= most_routes
+        assert any(inst.customers[customer] in r for r in ruined)
+        for route in ruined:
+            at = [k for k, c in enumerate(route) if c in taken]
+            assert at == list(range(at[0], at[-1] + 1))  # one run, no gaps
+            assert len(at) <= STRING_MOST
+        sizes.append(len(taken))
+    # on average E[routes] · E[length]: routes ⌊U(1, 3.64)⌋ (1, 2 or 3), lengths 1…10 alike
+    routes_max = 4 * STRING_MEAN / (1 + 10) - 1
+    mean_routes = (1 + 2 + 3 * (routes_max - 2)) / routes_max
+    assert np.mean(sizes) == pytest.approx(mean_routes * 5.5, rel=0.05)  # 10.2 of STRING_MEAN
+
+
+def test_customers_go_back_at_random_by_demand_or_by_distance_from_the_depot_as_sisr_draws():
+    """SISR's recreate orders, drawn 4 : 4 : 2 : 1 — at random, the largest demand first, the
+    farthest from the depot first, the nearest first — over five customers whose demands and
+    distances from the depot differ."""
+    xy = [(0.0, 0.0), (1.0, 0.0), (5.0, 0.0), (2.0, 0.0), (4.0, 0.0), (3.0, 0.0)]
+    inst = instance(xy, "dccccc", demand=np.array([0.0, 1, 5, 3, 4, 2]))
+    search = _Search(inst, np.random.default_rng(0))
+    by_demand, farthest = [2, 4, 3, 5, 1], [2, 4, 5, 3, 1]
+    seen = {"demand": 0, "farthest": 0, "nearest": 0, "other": 0}
+    draws = 2200
+    for _ in range(draws):
+        order = search._recreate_order({1, 2, 3, 4, 5})
+        assert sorted(order) == [1, 2, 3, 4, 5]
+        kind = {tuple(by_demand): "demand", tuple(farthest): "farthest"}.get(tuple(order))
+        seen[kind or ("nearest" if order == farthest[::-1] else "other")] += 1
+    # a random order is one of these by chance 1/120 of the time each
+    assert seen["demand"] / draws == pytest.approx(4 / 11, abs=0.04)
+    assert seen["farthest"] / draws == pytest.approx(2 / 11, abs=0.03)
+    assert seen["nearest"] / draws == pytest.approx(1 / 11, abs=0.03)
+    assert seen["other"] / draws == pytest.approx(4 / 11, abs=0.04)
