@@ -53,7 +53,8 @@ PRESETS: dict[str, Preset] = {
         "area c_d·A_f = 0.34 × 4.5 m²; light-truck tyres of EU label class B, c_r 0.0065; "
         "regeneration to 0.15 g, up to 70 kW): "
         "2,900 kg with driver, insulation kit and unit (the bare van's WLTP test mass is about "
-        "2,450 kg), 500 kg payload; a 9.5 m³ ATP 'IR' box (K = 0.35 W/(m²·K) ≤ 0.4) with an "
+        "2,450 kg), 500 kg payload (600 kg rated: 3,500 kg gross); a 9.5 m³ ATP 'IR' box "
+        "(K = 0.35 W/(m²·K) ≤ 0.4) with an "
         "inverter-driven electric unit (2.5 kW cooling, 1.5 kW heating, 150 W standby, COP a "
         "Carnot fraction), strip curtain; cab HVAC off at stops; battery derated in the cold; "
         "pre-conditioned at the depot. Validated (docs/validation.md): WLTC 3b at the plug "
@@ -61,6 +62,7 @@ PRESETS: dict[str, Preset] = {
         "of wall gain.",
         vehicle=VehicleParams(
             mass_kg=2900.0,
+            gross_mass_kg=3500.0,
             drag_coefficient=0.34,
             frontal_area_m2=4.5,
             rolling_resistance_coefficient=0.0065,

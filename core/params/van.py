@@ -22,6 +22,13 @@ class VehicleParams(Params):
         le=40_000,
         description="Empty vehicle mass incl. driver [kg] (Table 1 m); at least 100 kg.",
     )
+    gross_mass_kg: float | None = Field(
+        None,
+        ge=100,
+        le=60_000,
+        description="Technically permissible maximum laden mass (gross vehicle weight) [kg]: "
+        "mass_kg plus payload_kg may not exceed it; null: not checked.",
+    )
     drag_coefficient: float = Field(
         0.329,
         ge=0.05,
@@ -130,6 +137,14 @@ class VehicleParams(Params):
         description="Most electric power of the cab HVAC [W]: how fast it brings the cab back "
         "after a stop or a departure with a cold or hot cab; at least 100 W.",
     )
+
+    @field_validator("gross_mass_kg")
+    @classmethod
+    def _gross_above_empty(cls, value: float | None, info: ValidationInfo) -> float | None:
+        mass = info.data.get("mass_kg")
+        if value is not None and mass is not None and value < mass:
+            raise ValueError(f"gross_mass_kg must be at least mass_kg ({mass:g} kg)")
+        return value
 
 
 class BoxGeometry(Params):
@@ -618,6 +633,20 @@ class VanParams(Params):
         return self.model_copy(
             update={"refrigeration": self.refrigeration.priced(depot_price_per_kwh)}
         )
+
+    @field_validator("payload_kg")
+    @classmethod
+    def _within_gross_mass(cls, value: float, info: ValidationInfo) -> float:
+        vehicle = info.data.get("vehicle")
+        if vehicle is not None and vehicle.gross_mass_kg is not None:
+            rated = vehicle.gross_mass_kg - vehicle.mass_kg
+            if value > rated:
+                raise ValueError(
+                    f"payload_kg must be at most the van's rated payload, {rated:g} kg "
+                    f"(vehicle.gross_mass_kg {vehicle.gross_mass_kg:g} less vehicle.mass_kg "
+                    f"{vehicle.mass_kg:g})"
+                )
+        return value
 
     @field_validator("refrigeration")
     @classmethod

@@ -175,6 +175,12 @@ def _with(change) -> dict:
         (lambda b: b["vehicles"][0].update(shift_start="7:00"), "vehicles[0].shift_start"),
         (lambda b: b["vehicles"][0].update(shift_start=700), "vehicles[0].shift_start"),
         (lambda b: b["vehicles"][1].update(id="van-1"), "vehicles[1].id"),
+        (  # 40 t in a 3.5 t van: its rated payload is 600 kg
+            lambda b: b["vehicles"][1].update(
+                vehicle={"preset": "ev-van-3.5t-reefer"}, payload_kg=40_000
+            ),
+            "vehicles[1].payload_kg",
+        ),
         (
             lambda b: b["vehicles"][0]["vehicle"].update(preset="tesla"),
             "vehicles[0].vehicle.preset",

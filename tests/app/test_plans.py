@@ -98,6 +98,9 @@ def _stops(n):
         ({"timezone": "Mars/Olympus"}, "timezone"),
         ({"objective": "fun"}, "objective"),
         ({"payload_kg": -1}, "payload_kg"),
+        ({"vehicle": {"preset": "ev-van-3.5t-reefer"}, "payload_kg": 40_000}, "payload_kg"),
+        ({"vehicle": {"gross_mass_kg": 2000}, "payload_kg": 321}, "payload_kg"),
+        ({"vehicle": {"gross_mass_kg": 1500}}, "vehicle.gross_mass_kg"),
         ({"weather": {"t_min_c": 30, "t_max_c": 10}}, "weather.t_max_c"),
         (
             {

@@ -5,6 +5,7 @@ from zoneinfo import ZoneInfo
 
 import numpy as np
 import pytest
+from pydantic import ValidationError
 
 from core.params import PRESETS, Location, VehicleParams, Weather
 from core.physics.cargo import door_heat_w, refrigeration_cop, wall_heat_w
@@ -103,3 +104,18 @@ def test_cold_day_derates_the_real_van():
     result = simulate(np.zeros(601), 1.0, APRIL, VIENNA, VAN, weather=cold)
     assert result.battery_loss_kwh == pytest.approx(result.energy_kwh["total"] * (1 / 0.91 - 1))
     assert result.battery.usable_capacity_kwh == pytest.approx(68 * 0.88 / 0.91)
+
+
+def test_its_rated_payload_is_the_gross_weight_less_its_mass():
+    # A 3.5 t van (driving-licence class B): 3,500 kg gross less 2,900 kg with driver,
+    # insulation kit and unit leaves 600 kg; the preset's 500 kg is within it, 601 kg is not,
+    # nor 501 kg once the van weighs 100 kg more.
+    assert VAN.vehicle.gross_mass_kg == 3500.0
+    VAN.model_validate(VAN.model_dump() | {"payload_kg": 600.0})
+    with pytest.raises(ValidationError, match="rated payload, 600 kg"):
+        VAN.model_validate(VAN.model_dump() | {"payload_kg": 601.0})
+    heavier = VAN.model_dump()
+    heavier["vehicle"]["mass_kg"] = 3000.0
+    with pytest.raises(ValidationError, match="rated payload, 500 kg"):
+        VAN.model_validate(heavier | {"payload_kg": 501.0})
+    assert PRESETS["paper-generic"].vehicle.gross_mass_kg is None  # Table 1 gives no rating

@@ -31,13 +31,15 @@ START = dt.datetime(2026, 7, 15, 12, 0, tzinfo=ZoneInfo("Europe/Vienna"))
 HOT = Weather(t_min_c=25, t_max_c=38)
 SECTIONS = {"vehicle": VehicleParams, "cargo_box": CargoBoxParams, "battery": BatteryParams}
 #: Ends that another field's rule excludes, and what that field is then: the reserve below the
-#: departure charge, the product's limit above the set-point; with the value tested where the
+#: departure charge, the product's limit above the set-point, the gross mass above the empty
+#: one; with the value tested where the
 #: partner's own range excludes the very end.
 PARTNERS = {
     ("battery", "initial_soc"): ({"min_soc": 0.0}, None),
     ("battery", "min_soc"): ({"initial_soc": 1.0}, 0.99),
     ("cargo_box", "product_limit_c"): ({"setpoint_c": -40.0}, None),
     ("cargo_box", "setpoint_c"): ({"product_limit_c": 40.0}, None),
+    ("vehicle", "gross_mass_kg"): ({"mass_kg": 100.0}, None),
 }
 
 
