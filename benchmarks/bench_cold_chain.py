@@ -78,15 +78,17 @@ def rows_of(
         kept = kept or (result, seconds)
         unit, chain = result.refrigeration, result.cold_chain
         assert unit is not None and chain is not None
-        base = kept[0].refrigeration
-        assert base is not None
+        thermostat, best = unit.baselines
         rows.append(
             [
                 name,
                 label,
+                unit.followed,
                 f"{unit.battery_kwh:.2f}",
-                f"{(unit.battery_kwh / base.battery_kwh - 1) * 100:+.1f} %",
                 f"{unit.grid_kwh:.2f}",
+                f"{-thermostat.battery_saved * 100:+.1f} %",
+                f"{-best.battery_saved * 100:+.1f} % / {-best.total_saved * 100:+.1f} %",
+                f"{best.setpoint_c:.1f} ({best.battery_kwh:.2f} + {best.grid_kwh:.2f})",
                 "–" if unit.cost is None else f"{unit.cost:.3f}",
                 f"{chain.product_min_c:.1f} … {chain.product_max_c:.1f}",
                 chain.verdict,
@@ -106,9 +108,14 @@ def test_days() -> list[tuple[str, dict[str, Any]]]:
             reference_day(cargo_box={"product": "frozen", "load_temperature_c": -22.0}),
         ),
         (
+            "spring, chilled dairy",
+            reference_day(date="2026-04-15", weather={"t_min_c": 8, "t_max_c": 16}),
+        ),
+        (
             "winter, chilled dairy",
             reference_day(date="2026-01-15", weather={"t_min_c": -12, "t_max_c": -4}),
         ),
+        ("summer, 8 stops", reference_day(stops=reference_day()["stops"][:8])),
     ]
 
 
@@ -151,9 +158,12 @@ def main() -> None:
         [
             "day",
             "strategy",
+            "the unit follows",
             "refrigeration from the battery [kWh]",
-            "vs thermostat",
             "from the grid [kWh] (pre-cooling)",
+            "battery vs thermostat",
+            "vs best constant: battery / battery + grid",
+            "best constant [°C] (battery + grid [kWh])",
             "cost (battery refilled at the depot)",
             "goods [°C]",
             "cold chain",

@@ -16,7 +16,8 @@ from app.settings import Settings
 from core.arrays import FloatArray
 from core.exceptions import LimitExceededError
 from core.params import STREET_TYPES, CargoBoxParams
-from core.physics.cold_chain import check_cold_chain
+from core.physics.cargo import BoxResult
+from core.physics.cold_chain import box_check
 from core.physics.cycles import generate_leg
 from core.physics.simulate import check_trace, simulate
 from core.physics.weather import forecast_for
@@ -110,7 +111,7 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
             result.box.minutes_above_limit if dynamic else None,
             van.cargo_box.product_limit_c,
         ),
-        cold_chain=_cold_chain(van.cargo_box, result.box.product_c, request.dt_s),
+        cold_chain=_cold_chain(van.cargo_box, result.box, request.dt_s),
         series=series,
         grid_kwh=result.grid_kwh,
         warnings=[*warnings, *result.warnings],
@@ -124,12 +125,8 @@ def _at_samples(per_step: FloatArray) -> list[Any]:
     return [v if math.isfinite(v) else None for v in values]
 
 
-def _cold_chain(
-    box: CargoBoxParams, product_c: FloatArray | None, dt_s: float
-) -> ColdChainOut | None:
+def _cold_chain(box: CargoBoxParams, simulated: BoxResult, dt_s: float) -> ColdChainOut | None:
     band = box.band
-    if band is None or product_c is None:
+    if band is None or simulated.product_c is None:
         return None
-    return ColdChainOut(
-        **dict(ColdChainResult.of(band, check_cold_chain(band, product_c, dt_s), dt_s))
-    )
+    return ColdChainOut(**dict(ColdChainResult.of(band, box_check(band, simulated, dt_s))))

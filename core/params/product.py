@@ -5,7 +5,8 @@ Classes and their limits:
 
 * ``frozen``: quick-frozen foodstuffs at −18 °C or colder, brief rises of at most 3 °C in
   transport (Council Directive 89/108/EEC, art. 5 and Annex; ATP Annex 2: "other deep-frozen
-  foodstuffs" −18 °C).
+  foodstuffs" −18 °C); "brief" the rules leave open — a rise may last
+  :data:`BRIEF_RISE_MINUTES` at a time.
 * ``ice-cream``: −20 °C (ATP Annex 2), the same brief rise of 3 °C (89/108/EEC).
 * the chilled classes of ATP Annex 3 (highest temperature of the foodstuff in carriage):
   ``chilled-minced-meat`` +2 °C, ``chilled-offal`` +3 °C, ``chilled-poultry`` +4 °C,
@@ -27,6 +28,11 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, Discriminator, Field, Tag, ValidationInfo, field_validator
 
 from core.params.base import BRANCH_TAG, Params
+
+#: How long a brief rise of the goods above their band may last [min] unless the product says:
+#: the rules name no length (89/108/EEC art. 5: "brief upwards fluctuations"), so a stop's door
+#: opening and the recovery after it — half an hour.
+BRIEF_RISE_MINUTES = 30.0
 
 
 def _not_subnormal(value: float) -> float:
@@ -58,6 +64,16 @@ class ProductBand(Params):
         le=10,
         description="A brief rise above max_c the rules tolerate in transport [K] "
         "(quick-frozen food: 3 K, Directive 89/108/EEC); the cold chain breaks beyond it.",
+    )
+    excursion_minutes: float = Field(
+        BRIEF_RISE_MINUTES,
+        ge=0,
+        le=1440,
+        description="How long one rise above max_c (within excursion_c) may last [min]. "
+        "Directive 89/108/EEC (art. 5) allows quick-frozen food 'brief upwards fluctuations' "
+        "of at most 3 °C in distribution without saying how brief; coldroute takes 30 "
+        "minutes by default — a door opening at a stop and the recovery after it, not an "
+        "afternoon. A longer rise breaks the cold chain.",
     )
 
     @field_validator("max_c")

@@ -10,7 +10,9 @@ temperature, so the gain shrinks as the box warms.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -175,12 +177,27 @@ class BoxResult:
     setpoint_c
         The air set-point of each step the unit followed [°C] (the optimal strategy's
         schedule); None: ``setpoint_c`` throughout.
-    thermostat_power_w
-        With the optimal strategy: what a thermostat at ``setpoint_c`` would have drawn in
-        each step [W], for comparison.
+    thermostat
+        With the optimal strategy: the day of a thermostat at ``setpoint_c``, for comparison.
     precool_grid_j
         Electric energy the optimal strategy spent cooling at the depot before departure,
         from the grid [J].
+    product_before_c, seconds_before_s
+        The goods before the trace [°C] and how long each value lasted [s]: as loaded (or as
+        the van's state says, no length), then the optimal strategy's pre-cooling at the
+        depot (:func:`core.physics.cold_chain.goods_history`).
+    followed
+        What the unit followed: the thermostat at ``setpoint_c``, the optimal strategy's
+        schedule, or the best constant set-point where that beat the schedule.
+    best_constant
+        With a product: the best constant set-point's day on demand (it costs a search of
+        set-points; :func:`core.physics.cold_chain.best_constant`).
+    unheld
+        With a product: the first step in which the unit cannot hold the band's ceiling even
+        with the door shut, and why in words (None: it can).
+    notes
+        Warnings about the box's day (goods loaded outside their band, a unit too weak for
+        it, a band too narrow for the strategy).
     """
 
     power_w: FloatArray
@@ -192,8 +209,19 @@ class BoxResult:
     minutes_above_limit: float
     product_c: FloatArray | None = None
     setpoint_c: FloatArray | None = None
-    thermostat_power_w: FloatArray | None = None
+    thermostat: BoxResult | None = None
     precool_grid_j: float = 0.0
+    product_before_c: FloatArray = field(default_factory=lambda: np.zeros(0))
+    seconds_before_s: FloatArray = field(default_factory=lambda: np.zeros(0))
+    followed: Literal["thermostat", "schedule", "best-constant"] = "thermostat"
+    best_constant: Callable[[], Any] | None = None
+    unheld: tuple[int, str] | None = None
+    notes: tuple[str, ...] = ()
+
+    @property
+    def goods_before(self) -> tuple[FloatArray, FloatArray]:
+        """The goods before the trace [°C] and how long each value lasted [s]."""
+        return self.product_before_c, self.seconds_before_s
 
 
 #: Step of the dynamic box integration [s]: the box's time constant is many minutes even with

@@ -28,8 +28,10 @@ with the optimal strategy the schedule :mod:`core.physics.strategy` plans for th
 
 from __future__ import annotations
 
+import functools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 from numba import njit
@@ -43,7 +45,7 @@ from core.physics.cargo import (
     refrigeration_cop,
     wall_heat_w,
 )
-from core.physics.strategy import GRID_S, GRID_WEIGHT, BoxDay, optimal_schedule
+from core.physics.strategy import GRID_S, GRID_WEIGHT, BoxDay, margin_k, optimal_schedule
 
 #: Step of the two-node integration [s].
 BOX_STEP_S = 10.0
@@ -104,26 +106,14 @@ def two_nodes(
     n = conductance_w_k.size
     blocks = Blocks(n, round(BOX_STEP_S / dt_s))
     edges, counts, mean = blocks.edges, blocks.counts, blocks.mean
-
-    steady = box.mode == "steady"
-    cool_w = math.inf if steady else box.refrigeration_capacity_w
-    heat_w = (math.inf if steady else box.heating_capacity_w) if box.heater_enabled else 0.0
-    switching = (
-        (box.differential_k, box.min_on_minutes * 60.0, box.min_off_minutes * 60.0)
-        if box.control == "on-off"
-        else (0.0, 0.0, 0.0)
-    )
     mass = mean(payload_kg)
     cool_to, heat_to = setpoint_c if isinstance(setpoint_c, tuple) else (setpoint_c, setpoint_c)
-    air, product, removed, added = _integrate(
-        mean(conductance_w_k),
-        mean(equilibrium_c),
+    air, product, removed, added = _on_blocks(
+        box,
+        (air_capacity_j_k, mass),
+        (mean(conductance_w_k), mean(equilibrium_c)),
         (mean(cool_to), mean(heat_to)),
-        (air_capacity_j_k, mass * box.cargo_specific_heat_j_kgk),
-        mass * box.product_conductance_w_kgk,
         counts * dt_s,
-        (cool_w, heat_w),
-        switching,
         start_c,
     )
     product[mass <= 0] = np.nan
@@ -136,6 +126,38 @@ def two_nodes(
         product_c=np.repeat(product, counts),
         removed_w=np.repeat(removed, counts),
         added_w=np.repeat(added, counts),
+    )
+
+
+def _on_blocks(
+    box: CargoBoxParams,
+    capacity: tuple[float, FloatArray],
+    flows: tuple[FloatArray, FloatArray],
+    setpoint_c: tuple[FloatArray, FloatArray],
+    seconds: FloatArray,
+    start_c: tuple[float, float],
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """:func:`_integrate` over blocks of ``seconds`` with the box's unit: ``capacity`` the
+    air's [J/K] and the goods aboard [kg], ``flows`` the conductance [W/K] and the
+    equilibrium [°C], ``setpoint_c`` what it cools down to and heats up to."""
+    steady = box.mode == "steady"
+    cool_w = math.inf if steady else box.refrigeration_capacity_w
+    heat_w = (math.inf if steady else box.heating_capacity_w) if box.heater_enabled else 0.0
+    switching = (
+        (box.differential_k, box.min_on_minutes * 60.0, box.min_off_minutes * 60.0)
+        if box.control == "on-off"
+        else (0.0, 0.0, 0.0)
+    )
+    air_j_k, mass = capacity
+    return _integrate(
+        *flows,
+        setpoint_c,
+        (air_j_k, mass * box.cargo_specific_heat_j_kgk),
+        mass * box.product_conductance_w_kgk,
+        seconds,
+        (cool_w, heat_w),
+        switching,
+        start_c,
     )
 
 
@@ -237,12 +259,16 @@ Outside = tuple[FloatArray, FloatArray, FloatArray]
 class Setpoints:
     """What the unit follows through a trace, per step: the air it cools down to and the air
     it heats up to [°C]; with the air and the goods at departure [°C] after pre-cooling at the
-    depot, and what that drew from the grid [J]."""
+    depot, what that drew from the grid [J], and the air and the goods through it (each
+    step's end [°C] and length [s])."""
 
     cool_to_c: FloatArray
     heat_to_c: FloatArray
     departure_c: tuple[float, float]
     precool_grid_j: float = 0.0
+    depot_product_c: FloatArray = field(default_factory=lambda: np.zeros(0))
+    depot_seconds_s: FloatArray = field(default_factory=lambda: np.zeros(0))
+    depot_air_c: FloatArray = field(default_factory=lambda: np.zeros(0))
 
 
 def box_with_goods(
@@ -256,17 +282,257 @@ def box_with_goods(
     """The box of two nodes over steps of ``dt_s``: ``outside`` the ambient [°C], the sun [W]
     and the door's open share of each step; the goods aboard [kg]; ``start_c`` the air's and
     the goods' temperatures at the start [°C]; the unit a thermostat on the set-point, or on
-    the optimal strategy's schedule (pre-cooled at the depot from the grid)."""
-    thermostat = Setpoints(*(np.full(payload_kg.shape, box.setpoint_c),) * 2, start_c)
-    kept = follow(box, outside, payload_kg, dt_s, thermostat)
-    if run.strategy.strategy == "thermostat":
-        return kept
-    planned = plan_setpoints(box, outside, payload_kg, dt_s, start_c, run)
+    the optimal strategy's schedule (pre-cooled at the depot from the grid) — unless the best
+    constant set-point (:func:`best_constant`) keeps the goods at least as well for less by the
+    strategy's objective: then on that."""
+    day = DayInputs(outside, payload_kg, dt_s, start_c, run)
+    kept = follow(box, outside, payload_kg, dt_s, _constant(box.setpoint_c, payload_kg, start_c))
+    # the goods as loaded (none: the van leaves empty): a moment of no length
+    aboard = bool(payload_kg.size and payload_kg[0] > 0)
+    loaded = np.array([start_c[1] if aboard else np.nan])
+    unheld = _unheld(box, outside)
+    notes = (
+        *_loading_notes(box, start_c[1] if aboard else None),
+        *([] if unheld is None else [unheld[1]]),
+    )
+    # a steady box is held by assumption: only the rating says the unit cannot
+    held = unheld if box.mode == "steady" else None
+    narrow = _too_narrow(box) if run.strategy.strategy == "optimal" else ()
+    if run.strategy.strategy == "thermostat" or narrow:
+        return replace(
+            kept,
+            product_before_c=loaded,
+            seconds_before_s=np.zeros(1),
+            best_constant=functools.cache(functools.partial(best_constant, box, day)),
+            unheld=held,
+            notes=(*notes, *narrow),
+        )
+    unit = plan_unit(box, day)
+    if unit.followed == "best-constant":
+        chosen = replace(unit.box, setpoint_c=unit.setpoints.cool_to_c)
+    else:
+        chosen = replace(
+            unit.box,
+            setpoint_c=unit.setpoints.cool_to_c,
+            precool_grid_j=unit.setpoints.precool_grid_j,
+            product_before_c=np.concatenate((loaded, unit.setpoints.depot_product_c)),
+            seconds_before_s=np.concatenate(([0.0], unit.setpoints.depot_seconds_s)),
+        )
     return replace(
-        follow(box, outside, payload_kg, dt_s, planned),
-        setpoint_c=planned.cool_to_c,
-        thermostat_power_w=kept.power_w,
-        precool_grid_j=planned.precool_grid_j,
+        chosen,
+        product_before_c=chosen.product_before_c if chosen.product_before_c.size else loaded,
+        seconds_before_s=chosen.seconds_before_s if chosen.seconds_before_s.size else np.zeros(1),
+        followed=unit.followed,
+        thermostat=kept,
+        best_constant=lambda: unit.constant,
+        unheld=held,
+        notes=notes,
+    )
+
+
+@dataclass(frozen=True)
+class UnitPlan:
+    """What the optimal strategy has the unit follow through a day: the set-points, the box
+    following them, whether they are the programme's schedule or the best constant
+    set-point, and that set-point's day."""
+
+    setpoints: Setpoints
+    box: BoxResult
+    followed: Literal["schedule", "best-constant"]
+    constant: ConstantRun
+
+
+def plan_unit(box: CargoBoxParams, day: DayInputs) -> UnitPlan:
+    """The optimal strategy on ``day``: the programme's schedule
+    (:func:`plan_setpoints`), or the best constant set-point (:func:`best_constant`) where the
+    schedule would leave the goods out longer, cost more by the objective or, by the energy
+    objective, draw more from the battery. A re-plan under way runs this from the box's
+    state."""
+    args = (day.outside, day.payload_kg, day.dt_s)
+    planned = plan_setpoints(box, *args, day.start_c, day.run)
+    scheduled = follow(box, *args, planned)
+    constant = best_constant(box, day)
+    if _costlier(box, day, (scheduled, planned.precool_grid_j), (constant.box, 0.0)):
+        setpoints = _constant(constant.setpoint_c, day.payload_kg, constant.start_c)
+        return UnitPlan(setpoints, constant.box, "best-constant", constant)
+    return UnitPlan(planned, scheduled, "schedule", constant)
+
+
+def _loading_notes(box: CargoBoxParams, loaded_c: float | None) -> tuple[str, ...]:
+    """A warning for goods loaded outside their band (None: no goods aboard)."""
+    band = box.band
+    assert band is not None  # a box with a product
+    if loaded_c is None or band.min_c <= loaded_c <= band.max_c:
+        return ()
+    side = (
+        f"below their band's floor of {band.min_c:g} °C (chilled goods may have frozen)"
+        if loaded_c < band.min_c
+        else f"above their band's {band.max_c:g} °C"
+    )
+    return (
+        f"the goods are loaded at {loaded_c:g} °C, {side}: the cold chain is broken from "
+        "loading (cargo_box.load_temperature_c)",
+    )
+
+
+def _unheld(box: CargoBoxParams, outside: Outside) -> tuple[int, str] | None:
+    """The first step in which the walls and the sun alone bring more heat than the unit
+    removes with the air at the band's ceiling, and a warning saying so; None: none."""
+    band = box.band
+    assert band is not None  # a box with a product
+    load_w = wall_heat_w(box, outside[0], band.max_c) + outside[1]
+    over = np.flatnonzero(load_w > box.refrigeration_capacity_w)
+    if not over.size:
+        return None
+    at = int(over[0])
+    worst = int(np.argmax(load_w))
+    return (
+        at,
+        f"the unit's {box.refrigeration_capacity_w / 1000:.1f} kW cannot hold the goods' band: "
+        f"with {float(outside[0][worst]):.0f} °C outside, the walls and the sun alone bring "
+        f"{float(load_w[worst]) / 1000:.1f} kW into the box at {band.max_c:g} °C",
+    )
+
+
+def _too_narrow(box: CargoBoxParams) -> tuple[str, ...]:
+    """A warning when the product's band is too narrow for the optimal strategy to plan in:
+    narrower than its margins on both sides and an on-off unit's differential."""
+    band = box.band
+    assert band is not None  # a box with a product
+    swing = box.differential_k if box.control == "on-off" else 0.0
+    least = 2.0 * margin_k(band) + swing
+    if band.max_c - band.min_c >= least:
+        return ()
+    return (
+        f"the product's band ({band.max_c - band.min_c:g} K) is narrower than the optimal "
+        f"strategy plans in ({least:g} K: its margins and the unit's differential): the unit "
+        f"follows the thermostat at {box.setpoint_c:g} °C",
+    )
+
+
+@dataclass(frozen=True)
+class DayInputs:
+    """What a box's day is simulated from (:func:`box_with_goods`' arguments)."""
+
+    outside: Outside
+    payload_kg: FloatArray
+    dt_s: float
+    start_c: tuple[float, float]
+    run: Run
+
+
+def _constant(setpoint_c: float, payload_kg: FloatArray, start_c: tuple[float, float]) -> Setpoints:
+    """A thermostat's set-points: ``setpoint_c`` all day, from ``start_c``."""
+    return Setpoints(*(np.full(payload_kg.shape, setpoint_c),) * 2, start_c)
+
+
+def _costlier(
+    box: CargoBoxParams,
+    day: DayInputs,
+    planned: tuple[BoxResult, float],
+    constant: tuple[BoxResult, float],
+) -> bool:
+    """Whether the box ``planned`` (with what its pre-cooling drew from the grid [J]) leaves
+    the goods outside their band longer than the ``constant`` one, or costs more by the
+    strategy's objective — or, by the energy objective, takes more from the battery."""
+    weights, at_depot = day.run.weights()
+    on_battery = 1.0 - day.run.plugged
+
+    def measure(result: BoxResult, precool_j: float) -> tuple[float, float, float]:
+        power = result.power_w * day.dt_s
+        return (
+            _kelvin_minutes(box, result.product_c, day.dt_s),
+            float((power * weights).sum()) + at_depot * precool_j,
+            float((power * on_battery).sum()),
+        )
+
+    plan, steady = measure(*planned), measure(*constant)
+    if plan[0] > steady[0] + KELVIN_MINUTE_TOLERANCE:
+        return True
+    if plan[0] < steady[0] - KELVIN_MINUTE_TOLERANCE:
+        return False
+    energy = day.run.strategy.objective == "energy"
+    return plan[1] > steady[1] or (energy and plan[2] > steady[2])
+
+
+#: Goods this little outside their band count as in it [K·min]: the integration's rounding.
+KELVIN_MINUTE_TOLERANCE = 1e-3
+
+
+def _kelvin_minutes(box: CargoBoxParams, product_c: FloatArray | None, dt_s: float) -> float:
+    """How far and how long the goods were outside their band while aboard [K·min]."""
+    assert box.band is not None and product_c is not None  # a box with a product
+    aboard = np.nan_to_num(product_c, nan=box.band.middle_c)
+    outside_k = np.maximum(aboard - box.band.max_c, 0.0) + np.maximum(box.band.min_c - aboard, 0.0)
+    return float(outside_k.sum() * dt_s / 60.0)
+
+
+#: The constant set-points tried for the best thermostat, K apart: across the air's band, then
+#: around the best of those.
+SETPOINT_STEPS_K = (0.5, 0.1)
+
+
+@dataclass(frozen=True)
+class ConstantRun:
+    """The best constant set-point's day: the set-point [°C], the air and the goods it starts
+    from [°C] and the box following it."""
+
+    setpoint_c: float
+    start_c: tuple[float, float]
+    box: BoxResult
+
+
+def best_constant(box: CargoBoxParams, day: DayInputs) -> ConstantRun:
+    """The fair baseline: the constant air set-point within the product's band (an on-off
+    unit's: less half its differential) whose thermostat keeps the goods in their band on the
+    day (as far inside it as the strategy keeps them, :func:`core.physics.strategy.margin_k`),
+    for the least energy on the forecast by the strategy's objective — where none
+    keeps them in, the one that leaves them out least [K·min]. Tried every
+    :data:`SETPOINT_STEPS_K` on the integration's blocks (each a few milliseconds), the best
+    followed at full resolution; a box leaving the depot is pre-conditioned to its
+    set-point, as the thermostat's to its own."""
+    band = box.band
+    assert band is not None  # a box with a product
+    blocks = Blocks(day.payload_kg.size, round(BOX_STEP_S / day.dt_s))
+    mean = blocks.mean
+    seconds = blocks.counts * day.dt_s
+    mass = mean(day.payload_kg)
+    _, conductance, equilibrium = _flows(box, day.outside)
+    flows = (mean(conductance), mean(equilibrium))
+    ambient = mean(day.outside[0])
+    weight = mean(day.run.weights()[0]) * seconds
+    air_j_k = air_heat_capacity_j_k(box)
+    aboard = mass > 0
+    swing = 0.5 * box.differential_k if box.control == "on-off" else 0.0
+    low, high = min(band.min_c + swing, band.middle_c), max(band.max_c - swing, band.middle_c)
+
+    # the goods held as the strategy holds them: its margin inside the band
+    floor = min(band.min_c + margin_k(band), band.middle_c)
+    ceiling = max(band.max_c - margin_k(band), band.middle_c)
+
+    def start(setpoint_c: float) -> tuple[float, float]:
+        """A box that leaves the depot pre-conditioned to the set-point, or one under way."""
+        return (setpoint_c, day.start_c[1]) if day.run.from_depot else day.start_c
+
+    def score(setpoint_c: float) -> tuple[float, float]:
+        setpoint = np.full(seconds.size, setpoint_c)
+        air, product, removed, added = _on_blocks(
+            box, (air_j_k, mass), flows, (setpoint, setpoint), seconds, start(setpoint_c)
+        )
+        outside_k = np.maximum(product - ceiling, 0.0) + np.maximum(floor - product, 0.0)
+        minutes = float((outside_k * seconds)[aboard].sum() / 60.0)
+        power = removed / refrigeration_cop(box, ambient, air) + added / box.heating_cop
+        return round(minutes / KELVIN_MINUTE_TOLERANCE), float((power * weight).sum())
+
+    best = high
+    span = high - low
+    for step in SETPOINT_STEPS_K:
+        tried = np.linspace(best - span, best + span, round(2 * span / step) + 1)
+        best = min((float(t) for t in np.unique(np.clip(tried, low, high))), key=lambda t: score(t))
+        span = step
+    setpoints = _constant(best, day.payload_kg, start(best))
+    return ConstantRun(
+        best, start(best), follow(box, day.outside, day.payload_kg, day.dt_s, setpoints)
     )
 
 
@@ -350,7 +616,7 @@ def plan_setpoints(
     in. From a start under way (``run.from_depot`` false) it is the receding horizon's
     re-plan: the rest of the day from the box's state."""
     ambient = outside[0]
-    _, conductance, equilibrium = _flows(box, outside)
+    door_w_k, conductance, equilibrium = _flows(box, outside)
     weights, at_depot = run.weights()
     n = ambient.size
     per_block = max(round((grid_s or grid_step_s(n * dt_s)) / dt_s), 1)
@@ -368,6 +634,7 @@ def plan_setpoints(
                 refrigeration_cop(box, grid_outside, box.setpoint_c), grid_outside.shape
             ),
             weight=mean(weights),
+            door_open=mean(door_w_k),
         )
     ]
     m = math.ceil(run.strategy.precool_minutes * 60.0 / step_s) if run.from_depot and n else 0
@@ -389,7 +656,6 @@ def plan_setpoints(
     if m:
         goods = float(schedule.product_c[m - 1])
         departure = (float(schedule.air_c[m - 1]), goods if math.isfinite(goods) else start_c[1])
-    electric = (schedule.removed_w / day.cop + schedule.added_w / box.heating_cop) * day.seconds
     # the air the programme keeps, from one minute's end to the next (a step up would have the
     # heater chase it); the heater holds the floor, and the air where the programme heats
     air = schedule.air_c[m:]
@@ -398,35 +664,24 @@ def plan_setpoints(
         np.arange(1, n + 1) * dt_s, np.append(0.0, ends_s), np.append(departure[0], air)
     )
     heat_to = np.repeat(np.where(schedule.added_w[m:] > 0, air, box.band.min_c), counts)
-    precool_j = _precool_j(
-        box,
-        BoxDay(*(getattr(day, f)[:m] for f in BoxDay.__dataclass_fields__)),
-        electric[:m],
-        start_c,
+    depot = slice(0, m)
+    # the grid's energy at the depot: every joule of the unit there, the compressor's at the
+    # COP of the air it actually reached (the programme priced it at the set-point's)
+    precool_w = (
+        schedule.removed_w[depot]
+        / refrigeration_cop(box, day.equilibrium_c[depot], schedule.air_c[depot])
+        + schedule.added_w[depot] / box.heating_cop
+        + box.standby_power_w
     )
-    return Setpoints(cool_to, heat_to, departure, precool_j)
-
-
-def _precool_j(
-    box: CargoBoxParams, window: BoxDay, electric_j: FloatArray, start_c: tuple[float, float]
-) -> float:
-    """Pre-cooling: what the programme drew in the depot's ``window`` (``electric_j`` [J] per
-    step) beyond holding the box as it starts — what the thermostat's day assumes of those
-    minutes; at least nothing."""
-    if not window.seconds.size:
-        return 0.0
-    held = two_nodes(
-        box,
-        air_heat_capacity_j_k(box),
-        window.conductance_w_k,
-        window.equilibrium_c,
-        window.payload_kg,
-        np.full(window.seconds.size, start_c[0]),
-        float(window.seconds[0]),
-        start_c,
+    return Setpoints(
+        cool_to,
+        heat_to,
+        departure,
+        float((precool_w * day.seconds[depot]).sum()),
+        schedule.product_c[depot],
+        day.seconds[depot],
+        schedule.air_c[depot],
     )
-    holding = (held.removed_w / window.cop + held.added_w / box.heating_cop) * window.seconds
-    return max(float(electric_j.sum() - holding.sum()), 0.0)
 
 
 def _constant_day(
@@ -448,23 +703,28 @@ def _constant_day(
         payload_kg=np.full(m, payload_kg),
         cop=np.full(m, float(refrigeration_cop(box, ambient_c, box.setpoint_c))),
         weight=np.full(m, weight),
+        door_open=np.zeros(m),
     )
 
 
 @dataclass(frozen=True)
 class ColdChainCheck:
-    """Whether the goods stayed inside their band while aboard.
+    """Whether the goods stayed inside their band, by the rules, from their loading on.
 
     Attributes
     ----------
     holds
-        Never outside ``[min_c, max_c + excursion_c]``.
+        Never below ``min_c``, never above ``max_c + excursion_c``, and never above ``max_c``
+        for longer than ``excursion_minutes`` at a time.
     product_min_c, product_max_c
-        The coldest and warmest the goods were [°C] (None: no goods aboard).
+        The coldest and warmest the goods were [°C], as loaded included (None: no goods).
     minutes_outside_band
-        Time outside ``[min_c, max_c]`` [min].
+        Time outside ``[min_c, max_c]`` [min], pre-cooling at the depot included.
     first_break_step
-        The first step outside ``[min_c, max_c + excursion_c]`` (None: it holds).
+        The step of the trace in which it first breaks: −1 before departure (as loaded or
+        while pre-cooling), None: it holds.
+    first_break_s
+        When it first breaks, seconds after departure (0: before it); None: it holds.
     reason
         Why it breaks, in words (None: it holds).
     """
@@ -475,33 +735,110 @@ class ColdChainCheck:
     minutes_outside_band: float
     first_break_step: int | None
     reason: str | None
+    first_break_s: float | None = None
 
 
-def check_cold_chain(band: ProductBand, product_c: FloatArray, dt_s: float) -> ColdChainCheck:
-    """The goods' temperatures ``product_c`` per step of ``dt_s`` (NaN: none aboard) held to
-    ``band``."""
+#: The goods' temperatures before a trace [°C] and how long each lasted [s]
+#: (:attr:`core.physics.cargo.BoxResult.goods_before`).
+Before = tuple[FloatArray, FloatArray]
+NOTHING_BEFORE: Before = (np.zeros(0), np.zeros(0))
+
+
+def goods_history(
+    product_c: FloatArray, dt_s: float, before: Before = NOTHING_BEFORE
+) -> tuple[FloatArray, FloatArray, int]:
+    """The goods' temperatures [°C] from their loading on, each with how long it lasted [s]:
+    ``before`` the trace (as loaded, no length; the pre-cooling at the depot), then each step
+    of ``dt_s`` of the trace ``product_c`` (NaN: none aboard); and how many samples precede
+    the trace."""
+    values, seconds = before
+    return (
+        np.concatenate((values, product_c)),
+        np.concatenate((seconds, np.full(product_c.size, dt_s))),
+        values.size,
+    )
+
+
+def box_check(band: ProductBand, box: BoxResult, dt_s: float) -> ColdChainCheck:
+    """The cold chain of ``box`` (its trace in steps of ``dt_s``, with a product): its goods
+    from their loading on, and a unit its rating says cannot hold them."""
+    assert box.product_c is not None  # a box with a product
+    return check_cold_chain(band, box.product_c, dt_s, box.goods_before, box.unheld)
+
+
+def check_cold_chain(
+    band: ProductBand,
+    product_c: FloatArray,
+    dt_s: float,
+    before: Before = NOTHING_BEFORE,
+    unheld: tuple[int, str] | None = None,
+) -> ColdChainCheck:
+    """The goods' temperatures ``product_c`` per step of ``dt_s`` (NaN: none aboard), with
+    what they were ``before`` the trace, held to ``band`` by the rules: the floor and the
+    ceiling with its brief rise at every moment from their loading on, and each rise above
+    ``max_c`` no longer than ``excursion_minutes`` (:class:`core.params.ProductBand`); broken
+    too from the step ``unheld`` names on, for the reason it gives (a unit too weak for the
+    band, which a steady box does not show)."""
+    product_c, seconds, before_n = goods_history(product_c, dt_s, before)
     aboard = np.isfinite(product_c)
     if not aboard.any():
         return ColdChainCheck(True, None, None, 0.0, None, None)
     values = product_c[aboard]
-    outside = aboard & ((product_c < band.min_c) | (product_c > band.max_c))
+    above = aboard & (product_c > band.max_c + 1e-9)
+    outside = above | (aboard & (product_c < band.min_c - 1e-9))
     ceiling = band.max_c + band.excursion_c
-    warm = aboard & (product_c > ceiling + 1e-9)
-    cold = aboard & (product_c < band.min_c - 1e-9)
-    broken = np.flatnonzero(warm | cold)
-    reason = None
-    if broken.size:
-        at = float(product_c[broken[0]])
-        reason = (
-            f"the goods reached {at:.1f} °C, above their band's {ceiling:g} °C"
-            if warm[broken[0]]
-            else f"the goods fell to {at:.1f} °C, below their band's floor of {band.min_c:g} °C"
-        )
+    reasons = {
+        "warm": aboard & (product_c > ceiling + 1e-9),
+        "cold": aboard & (product_c < band.min_c - 1e-9),
+        "long": _rise_too_long(above, seconds, band.excursion_minutes * 60.0),
+    }
+    reasons["unheld"] = np.zeros(product_c.size, dtype=bool)
+    if unheld is not None:
+        reasons["unheld"][before_n + unheld[0]] = True
+    broken = np.flatnonzero(reasons["warm"] | reasons["cold"] | reasons["long"] | reasons["unheld"])
+    if not broken.size:
+        minutes = float(seconds[outside].sum() / 60.0)
+        return ColdChainCheck(True, float(values.min()), float(values.max()), minutes, None, None)
+    at = int(broken[0])
+    kind = next(k for k, flags in reasons.items() if flags[at])
+    elapsed_s = float(seconds[before_n : at + 1].sum()) if at >= before_n else 0.0
     return ColdChainCheck(
-        holds=not broken.size,
+        holds=False,
         product_min_c=float(values.min()),
         product_max_c=float(values.max()),
-        minutes_outside_band=float(outside.sum() * dt_s / 60.0),
-        first_break_step=int(broken[0]) if broken.size else None,
-        reason=reason,
+        minutes_outside_band=float(seconds[outside].sum() / 60.0),
+        first_break_step=at - before_n if at >= before_n else -1,
+        reason=(
+            unheld[1]
+            if kind == "unheld" and unheld is not None
+            else _why(band, kind, float(product_c[at]), at < before_n)
+        ),
+        first_break_s=elapsed_s,
+    )
+
+
+def _rise_too_long(above: np.ndarray, seconds: FloatArray, limit_s: float) -> np.ndarray:
+    """The samples of each unbroken stretch ``above`` the band at which it has lasted longer
+    than ``limit_s`` [s]."""
+    lasted = np.cumsum(np.where(above, seconds, 0.0))
+    # each stretch counts from the time lasted before it began
+    began = np.maximum.accumulate(np.where(above, 0.0, lasted))
+    return above & (lasted - began > limit_s + 1e-9)
+
+
+def _why(band: ProductBand, kind: str, at_c: float, before_departure: bool) -> str:
+    """The reason a chain breaks, in words."""
+    when = " before departure (as loaded or at the depot)" if before_departure else ""
+    if kind == "warm":
+        return (
+            f"the goods reached {at_c:.1f} °C{when}, above their band's "
+            f"{band.max_c + band.excursion_c:g} °C"
+        )
+    if kind == "cold":
+        return (
+            f"the goods fell to {at_c:.1f} °C{when}, below their band's floor of {band.min_c:g} °C"
+        )
+    return (
+        f"the goods stayed above their band's {band.max_c:g} °C for longer than the brief rise "
+        f"the rules allow ({band.excursion_minutes:g} min){when}"
     )

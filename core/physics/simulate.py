@@ -339,7 +339,7 @@ def _result(
         weather=outside.first_day,
         weather_days=outside.days,
         weather_source=outside.source,
-        warnings=trace.warnings,
+        warnings=[*trace.warnings, *box.notes],
         charges=charges,
         asked_s=trace.asked_s,
         plugged=plugged_share(trace.charging, n - 1, dt_s),

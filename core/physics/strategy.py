@@ -15,13 +15,16 @@ hold is answered, the slack saying where). The box's equations are
     (p_k + H_k)·ϑp_k − H_k·ϑa_k                 = p_k·ϑp_{k−1}
 
 with ``a = C_a/Δt``, ``p_k = C_p,k/Δt``. The goods stay within their band less a margin while
-aboard; the air within the band (an EN 12830 recorder logs it). The objective is
+aboard; the air within the band (an EN 12830 recorder logs it) but while a door is open. The
+objective is
 ``Σ (q_k/COP_k + h_k/COP_h)·Δt·w_k`` with ``w_k`` 1 on the battery and, while plugged in,
 :data:`GRID_WEIGHT` (objective 'energy': the grid's energy is not the battery's, but not free
 either) or the charger's price over the battery's — the depot's over the charging efficiency
 (objective 'cost': :meth:`core.physics.cold_chain.Run.weights`);
 ``COP_k`` the unit's at the step's outside temperature and the set-point (eq. 12 with the
-'carnot' model, linear in the decisions). The air temperatures found are the set-point
+'carnot' model, linear in the decisions). The goods' band is the rule (89/108/EEC, ATP); the
+air's is relaxed while a door is open, as the rules allow: fighting an open door the unit
+cannot win against only blows cold air out. The air temperatures found are the set-point
 schedule; the full simulation then follows it with the unit's thermostat and has the last
 word. An on-off unit's duty is planned as its mean over each step (the relaxation: the
 mixed-integer programme with its runs and pauses took 26 s for a day, against 0.1 s), the
@@ -52,6 +55,17 @@ GRID_S = 60.0
 GRID_WEIGHT = 0.1
 #: How far inside their band the goods are planned to stay [K]: the doors and arrivals vary.
 MARGIN_K = 0.5
+#: ... and at least this share of the band's width: a wide band's goods (frozen: 12 K) drift
+#: further on a day as driven than a narrow one's.
+MARGIN_SHARE = 0.1
+
+
+def margin_k(band: ProductBand) -> float:
+    """How far inside ``band`` the goods are planned [K]: :data:`MARGIN_K`, or
+    :data:`MARGIN_SHARE` of its width if more."""
+    return max(MARGIN_K, MARGIN_SHARE * (band.max_c - band.min_c))
+
+
 #: The price of the goods (and of the air) outside their band in the objective [kWh per
 #: kelvin and minute]: far above any energy, so the band is kept wherever the unit can.
 SLACK_PENALTY = 100.0
@@ -62,7 +76,8 @@ AIR_PENALTY = 1.0
 class BoxDay:
     """The day on the programme's grid, per step: its length [s], the box's conductance
     ``G`` [W/K] and equilibrium ``ϑ_eq`` [°C] (walls, door and sun), the goods aboard [kg], the
-    unit's cooling COP [–] and what a joule drawn then weighs in the objective."""
+    unit's cooling COP [–], what a joule drawn then weighs in the objective, and the open
+    door's conductance [W/K] (the air may leave its band where it is above 0; None: never)."""
 
     seconds: FloatArray
     conductance_w_k: FloatArray
@@ -70,6 +85,7 @@ class BoxDay:
     payload_kg: FloatArray
     cop: FloatArray
     weight: FloatArray
+    door_open: FloatArray | None = None
 
 
 @dataclass(frozen=True)
@@ -99,7 +115,7 @@ def optimal_schedule(
     held_steps: int = 0,
 ) -> Schedule:
     """The unit's removed and added heat per step of ``day`` at the least weighted energy,
-    the goods within ``band`` less :data:`MARGIN_K` while aboard and the air within the band,
+    the goods within ``band`` less :func:`margin_k` while aboard and the air within the band,
     from the air and the goods at ``start_c`` (module docstring); through the first
     ``held_steps`` (at the depot) no warmer than at the start: pre-cooling only cools. For an
     on-off unit the programme plans its duty (the heat it removes is its mean over the
@@ -183,16 +199,19 @@ def _band_rows(
     n = day.seconds.size
     aboard = np.flatnonzero(day.payload_kg > 0)
     everywhere = np.arange(n)
+    # the goods' band is the rule; the air may leave its band while a door is open
+    shut = everywhere if day.door_open is None else np.flatnonzero(day.door_open <= 0)
     held_steps, start_c = held
-    goods_high = np.full(n, max(band.max_c - MARGIN_K, band.middle_c))
+    margin = margin_k(band)
+    goods_high = np.full(n, max(band.max_c - margin, band.middle_c))
     goods_high[:held_steps] = np.minimum(goods_high[:held_steps], start_c[1])
     air_high = np.full(n, max(band.max_c - swing_k, band.middle_c))
     air_high[:held_steps] = np.minimum(air_high[:held_steps], start_c[0])
-    low = min(band.min_c + MARGIN_K, band.middle_c)
+    low = min(band.min_c + margin, band.middle_c)
     limits = [  # variable, its slack, the steps, the sign, the bound in each step
         (_TP, _S, aboard, 1.0, goods_high),
         (_TP, _S, aboard, -1.0, np.full(n, -low)),
-        (_TA, _U, everywhere, 1.0, air_high),
+        (_TA, _U, shut, 1.0, air_high),
         (_TA, _U, everywhere, -1.0, np.full(n, -min(band.min_c + swing_k, band.middle_c))),
     ]
     row = np.arange(sum(s.size for _, _, s, _, _ in limits))

@@ -633,17 +633,21 @@ class ColdChainResult(Result):
 
     verdict: Literal["holds", "breaks"] = Field(
         ...,
-        description="holds: the goods never left [min_c, max_c + excursion_c] while aboard; "
-        "breaks: they did (first_break_stop and reason say where and why).",
+        description="holds: from their loading on, the goods were never below min_c, never "
+        "above max_c + excursion_c, and never above max_c for longer than excursion_minutes "
+        "at a time; breaks: they were (first_break_stop and reason say where and why). Goods "
+        "loaded outside their band break it from the first minute.",
     )
     product_min_c: float | None = Field(
-        ..., description="The coldest the goods were while aboard [°C]."
+        ..., description="The coldest the goods were, as loaded included [°C]."
     )
     product_max_c: float | None = Field(
-        ..., description="The warmest the goods were while aboard [°C]."
+        ..., description="The warmest the goods were, as loaded included [°C]."
     )
     minutes_outside_band: float = Field(
-        ..., description="Time with the goods outside [min_c, max_c] [min]."
+        ...,
+        description="Time with the goods outside [min_c, max_c], pre-cooling at the depot "
+        "included [min].",
     )
     first_break_stop: str | None = Field(
         ...,
@@ -651,32 +655,54 @@ class ColdChainResult(Result):
         "it holds, or it breaks after the last stop).",
     )
     first_break_s: float | None = Field(
-        None, description="When it first breaks, seconds after the start; null: it holds."
+        None,
+        description="When it first breaks, seconds after the start (0: before departure, as "
+        "loaded or while pre-cooling at the depot); null: it holds.",
     )
     reason: str | None = Field(..., description="Why it breaks, in words; null: it holds.")
     min_c: float = Field(..., description="The band's floor [°C].")
     max_c: float = Field(..., description="The band's ceiling [°C].")
     excursion_c: float = Field(..., description="The brief rise above max_c tolerated [K].")
+    excursion_minutes: float = Field(
+        ..., description="How long one rise above max_c may last [min] (product.excursion_minutes)."
+    )
 
     @classmethod
     def of(
-        cls, band: ProductBand, check: ColdChainCheck, dt_s: float, stop: str | None = None
+        cls, band: ProductBand, check: ColdChainCheck, stop: str | None = None
     ) -> ColdChainResult:
-        """The verdict of ``check`` (over steps of ``dt_s``) on ``band``; ``stop``: where it
-        first breaks."""
-        step = check.first_break_step
+        """The verdict of ``check`` on ``band``; ``stop``: where it first breaks."""
         return cls(
             verdict="holds" if check.holds else "breaks",
             product_min_c=check.product_min_c,
             product_max_c=check.product_max_c,
             minutes_outside_band=check.minutes_outside_band,
             first_break_stop=stop,
-            first_break_s=None if step is None else (step + 1) * dt_s,
+            first_break_s=check.first_break_s,
             reason=check.reason,
             min_c=band.min_c,
             max_c=band.max_c,
             excursion_c=band.excursion_c,
+            excursion_minutes=band.excursion_minutes,
         )
+
+
+class DeliveredGoods(Result):
+    """The goods handed over at a stop: what they went through from their loading on."""
+
+    product_max_c: float | None = Field(
+        ...,
+        description="The warmest they were, as loaded included, until handed over [°C] (null: "
+        "none were aboard).",
+    )
+    minutes_above_band: float = Field(
+        ..., description="Time above the band's max_c until handed over [min]."
+    )
+    verdict: Literal["holds", "breaks"] = Field(
+        ...,
+        description="breaks: the cold chain broke before they were handed over (the day's "
+        "cold_chain says where and why); holds: it had not.",
+    )
 
 
 class ScheduleInterval(Result):
@@ -687,6 +713,36 @@ class ScheduleInterval(Result):
     power_w: float = Field(..., description="The unit's mean electric power [W].")
     air_setpoint_c: float = Field(
         ..., description="The air set-point the unit follows [°C] (its mean over the stretch)."
+    )
+
+
+class Baseline(Result):
+    """A thermostat the day's unit is measured against: one set-point held all day."""
+
+    name: Literal["thermostat", "best-constant"] = Field(
+        ...,
+        description="thermostat: the configured cargo_box.setpoint_c; best-constant: the "
+        "constant set-point within the product's band that keeps the goods in it on this day "
+        "for the least energy (the fair baseline of a strategy).",
+    )
+    setpoint_c: float = Field(..., description="Its set-point [°C].")
+    battery_kwh: float = Field(..., description="What it draws from the battery [kWh].")
+    grid_kwh: float = Field(..., description="What it draws from the grid, plugged in [kWh].")
+    cost: float | None = Field(
+        None, description="What its energy costs, as refrigeration.cost; null without a price."
+    )
+    cold_chain: Literal["holds", "breaks"] = Field(
+        ..., description="Whether the goods keep to their band with it, by cold_chain's rules."
+    )
+    battery_saved: float = Field(
+        ...,
+        description="The share of its battery energy the day's unit does without [–] "
+        "(negative: the unit draws more).",
+    )
+    total_saved: float = Field(
+        ...,
+        description="The share of its battery and grid energy together the day's unit does "
+        "without [–] (negative: the unit draws more).",
     )
 
 
@@ -726,6 +782,17 @@ class RefrigerationResult(Result):
         description="The unit's set-point and power, stretch by stretch (a set-point schedule "
         "a unit's controller can load).",
     )
+    followed: Literal["thermostat", "schedule", "best-constant"] = Field(
+        "thermostat",
+        description="What the unit follows: the thermostat at cargo_box.setpoint_c, the "
+        "optimal strategy's schedule, or — where the schedule would not beat it — the best "
+        "constant set-point (baselines).",
+    )
+    baselines: list[Baseline] = Field(
+        default_factory=list,
+        description="The day's unit against the configured thermostat and the best constant "
+        "set-point (a box with a product).",
+    )
 
 
 class StopResult(Result):
@@ -760,6 +827,11 @@ class StopResult(Result):
     product_temperature_c: Temperatures | None = Field(
         None,
         description="The goods on arrival and on departure [°C]; null: the box has no product.",
+    )
+    goods: DeliveredGoods | None = Field(
+        None,
+        description="The goods handed over here and the cold chain until then; null: the box "
+        "has no product.",
     )
 
 

@@ -160,15 +160,42 @@ def check_battery(route: dict[str, Any]) -> None:
         assert battery["first_infeasible_leg"] is not None, battery
 
 
+def check_cold_chain(route: dict[str, Any]) -> None:
+    """A round's cold-chain verdict, its deliveries' and its baselines against its own
+    numbers."""
+    chain = route.get("cold_chain")
+    if not chain:
+        return
+    low, high = chain["product_min_c"], chain["product_max_c"]
+    inside = chain["min_c"] <= low and high <= chain["max_c"] + chain["excursion_c"]
+    if chain["verdict"] == "holds":
+        assert inside and chain["reason"] is None and chain["first_break_s"] is None, chain
+    else:
+        too_long = chain["minutes_outside_band"] > chain["excursion_minutes"]
+        assert chain["reason"] and (not inside or too_long or "cannot hold" in chain["reason"])
+    delivered = [stop["goods"] for stop in route["stops"] if stop.get("goods")]
+    warmest = [goods["product_max_c"] for goods in delivered]
+    assert warmest == sorted(warmest) and all(w <= high + 1e-9 for w in warmest), warmest
+    verdicts = [goods["verdict"] for goods in delivered]
+    assert verdicts == sorted(verdicts, key=lambda v: v == "breaks"), verdicts
+    assert chain["verdict"] == "breaks" or "breaks" not in verdicts, verdicts
+    unit = route.get("refrigeration") or {}
+    for baseline in unit.get("baselines", []):
+        saved = 1 - unit["battery_kwh"] / baseline["battery_kwh"] if baseline["battery_kwh"] else 0
+        assert abs(baseline["battery_saved"] - saved) < 1e-9, baseline
+
+
 def check_answer(answer: Any) -> None:
     """Every round in a plan, a fleet plan or a job's result."""
     if not isinstance(answer, dict):
         return
     if "battery" in answer and "legs" in answer:
         check_battery(answer)
+        check_cold_chain(answer)
     for route in answer.get("routes", []) if isinstance(answer.get("routes"), list) else []:
         if isinstance(route, dict) and "battery" in route:
             check_battery(route)
+            check_cold_chain(route)
     if isinstance(answer.get("result"), dict):
         check_answer(answer["result"])
 

@@ -6,6 +6,7 @@ naming the field."""
 from __future__ import annotations
 
 import copy
+import datetime as dt
 import itertools
 from typing import Any
 
@@ -28,8 +29,11 @@ def check_agrees(answer: dict[str, Any]) -> dict[str, Any]:
     chain = answer["cold_chain"]
     low, high = chain["product_min_c"], chain["product_max_c"]
     inside = chain["min_c"] <= low and high <= chain["max_c"] + chain["excursion_c"]
-    assert chain["verdict"] == ("holds" if inside else "breaks")
-    assert (chain["reason"] is None) == inside
+    if not inside:
+        assert chain["verdict"] == "breaks"
+    elif chain["minutes_outside_band"] <= chain["excursion_minutes"]:  # no rise too long
+        assert chain["verdict"] == "holds"
+    assert (chain["reason"] is None) == (chain["verdict"] == "holds")
     assert (chain["minutes_outside_band"] == 0) == (
         chain["min_c"] <= low and high <= chain["max_c"]
     )
@@ -136,11 +140,10 @@ def test_a_simulated_trace_carries_the_air_and_the_goods_and_their_verdict(clien
     series, chain = data["series"], data["cold_chain"]
     goods = series["product_temperature_c"]
     assert len(goods) == len(series["time_s"]) == len(series["air_temperature_c"])
-    # loaded at 4.5 °C, above poultry's 4 °C: broken from the first step, said so
-    assert chain["verdict"] == "breaks" and chain["first_break_s"] == pytest.approx(
-        series["time_s"][1]
-    )
-    assert chain["product_max_c"] == pytest.approx(max(goods), abs=1e-9)
+    # loaded at 4.5 °C, above poultry's 4 °C: broken as loaded, before the first step, said so
+    assert chain["verdict"] == "breaks" and chain["first_break_s"] == 0.0
+    assert "4.5 °C before departure (as loaded" in chain["reason"]
+    assert chain["product_max_c"] == 4.5 and max(goods) < 4.5
     assert chain["product_min_c"] == pytest.approx(min(goods), abs=1e-9)
     plain = client.post("/v1/simulate", json=SIMULATE_EXAMPLE | {"include_series": True}).json()
     assert plain["cold_chain"] is None and plain["series"]["product_temperature_c"] is None
@@ -202,8 +205,36 @@ def test_the_optimal_strategy_spares_the_battery_and_says_its_schedule(client):
         assert schedule[0]["start"] == answer["legs"][0]["depart"]
         assert schedule[-1]["end"] == answer["legs"][-1]["arrive"]
         assert all(a["end"] == b["start"] for a, b in itertools.pairwise(schedule))
+    # the air floats within dairy's band, but where a door is open (and the unit recovers)
+    doors = [
+        (dt.datetime.fromisoformat(stop["arrival"]), dt.datetime.fromisoformat(stop["departure"]))
+        for stop in answers["optimal"]["stops"]
+    ]
+    recovery = dt.timedelta(seconds=600)
+    shut = [
+        s["air_setpoint_c"]
+        for s in planned["schedule"]
+        if not any(
+            dt.datetime.fromisoformat(s["start"]) < leave + recovery
+            and dt.datetime.fromisoformat(s["end"]) > come
+            for come, leave in doors
+        )
+    ]
+    assert shut and min(shut) >= 0.0 and max(shut) <= 6.0 + 0.5
     setpoints = [s["air_setpoint_c"] for s in planned["schedule"]]
-    assert 0.0 <= min(setpoints) < 3.0 < max(setpoints) <= 6.0  # floats within dairy's band
+    assert min(setpoints) < 3.0 < max(setpoints)  # colder at the depot, warmer on the road
+    # measured against the thermostat it replaces and the best constant set-point, which it
+    # beats on the battery (or follows)
+    thermostat, best = planned["baselines"]
+    assert (thermostat["name"], best["name"]) == ("thermostat", "best-constant")
+    assert thermostat["battery_kwh"] == pytest.approx(kept["battery_kwh"], rel=1e-9)
+    same = ("setpoint_c", "battery_kwh", "grid_kwh", "cold_chain")
+    assert {k: kept["baselines"][1][k] for k in same} == {k: best[k] for k in same}
+    assert planned["followed"] == "schedule"
+    assert planned["battery_kwh"] <= best["battery_kwh"] and best["cold_chain"] == "holds"
+    assert best["battery_saved"] == pytest.approx(
+        1 - planned["battery_kwh"] / best["battery_kwh"], rel=1e-9
+    )
     # the battery verdict rests on the strategy's energy
     thermostat_soc = answers["thermostat"]["battery"]["min_soc"]
     assert answers["optimal"]["battery"]["min_soc"] > thermostat_soc
@@ -364,3 +395,61 @@ def test_the_receding_horizon_re_plans_the_strategy_from_the_state_the_van_repor
     assert check_agrees(data)["verdict"] == "holds"
     assert data["cold_chain"]["product_max_c"] <= 6.0
     assert data["stops"][0]["air_temperature_c"]["arrival"] < 9.0
+
+
+def test_goods_loaded_warm_break_the_verdict_from_loading_with_either_strategy(client):
+    # dairy loaded at +12 °C: the optimal strategy pre-cools them at the depot for an hour,
+    # the thermostat on the road — either way the chain broke at loading, the warmest they
+    # were is 12 °C, every delivery says so, and the answer warns of it
+    cargo = DYNAMIC | {"product": "chilled-dairy", "load_temperature_c": 12.0}
+    for strategy in ("thermostat", "optimal"):
+        body = PLAN_EXAMPLE | {"cargo_box": cargo, "refrigeration": {"strategy": strategy}}
+        answer = client.post("/v1/plans", json=body).json()
+        chain = answer["cold_chain"]
+        assert chain["verdict"] == "breaks" and chain["first_break_s"] == 0.0, strategy
+        assert chain["product_max_c"] == 12.0 and chain["minutes_outside_band"] > 20.0
+        assert chain["first_break_stop"] == answer["stops"][0]["id"]
+        assert all(stop["goods"]["verdict"] == "breaks" for stop in answer["stops"])
+        assert all(stop["goods"]["product_max_c"] == 12.0 for stop in answer["stops"])
+        assert any("loaded at 12 °C, above their band's 6 °C" in w for w in answer["warnings"])
+
+
+def test_each_delivery_says_what_its_goods_went_through(client):
+    # frozen goods loaded at −19 °C on a hot day in a weak unit warm through the band's
+    # ceiling: the deliveries before that hold, the later ones break, each with the warmest
+    # its goods were and their minutes above the band until handed over
+    cargo = DYNAMIC | {
+        "product": "frozen",
+        "load_temperature_c": -18.5,
+        "setpoint_c": -18.5,
+        "refrigeration_capacity_w": 700.0,
+    }
+    answer = client.post("/v1/plans", json=PLAN_EXAMPLE | {"cargo_box": cargo}).json()
+    chain, stops = answer["cold_chain"], answer["stops"]
+    goods = [stop["goods"] for stop in stops]
+    assert goods[-1]["product_max_c"] <= chain["product_max_c"]
+    assert [g["product_max_c"] for g in goods] == sorted(g["product_max_c"] for g in goods)
+    arrivals = [stop["product_temperature_c"]["arrival"] for stop in stops]
+    for delivered, arrival in zip(goods, arrivals, strict=True):
+        assert delivered["product_max_c"] >= arrival - 1e-9
+        assert (delivered["minutes_above_band"] > 0) == (delivered["product_max_c"] > -18.0)
+    if chain["verdict"] == "breaks":
+        index = [stop["id"] for stop in stops].index(chain["first_break_stop"])
+        assert all(g["verdict"] == "holds" for g in goods[:index])
+        assert all(g["verdict"] == "breaks" for g in goods[index + 1 :])
+
+
+def test_frozen_goods_in_the_papers_steady_box_on_a_hot_day_break_for_want_of_capacity(client):
+    # paper-generic's 3 kW unit and K = 2.172 W/(m²·K) box: at 35 °C the walls alone bring
+    # 2.172 × 30.6 × 53 ≈ 3.5 kW at −18 °C; the steady box would hold it by assumption
+    body = PLAN_EXAMPLE | {
+        "vehicle": {"preset": "paper-generic"},
+        "cargo_box": {"product": "frozen"},
+        "weather": {"t_min_c": 25, "t_max_c": 35},
+    }
+    answer = client.post("/v1/plans", json=body)
+    assert answer.status_code == 200, answer.text[:300]
+    data = answer.json()
+    chain = data["cold_chain"]
+    assert chain["verdict"] == "breaks" and "3.0 kW cannot hold the goods' band" in chain["reason"]
+    assert chain["reason"] in data["warnings"]

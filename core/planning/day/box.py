@@ -14,11 +14,13 @@ from core.arrays import FloatArray
 from core.params import CargoBoxParams, VanParams
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.cargo import BoxResult
-from core.physics.cold_chain import check_cold_chain
+from core.physics.cold_chain import box_check, goods_history
 from core.physics.simulate import SimulationResult
 from core.planning.day.timeline import PLAN_DT_S
 from core.planning.model import (
+    Baseline,
     ColdChainResult,
+    DeliveredGoods,
     RefrigerationResult,
     ScheduleInterval,
     Temperatures,
@@ -47,12 +49,39 @@ def cold_chain(
     band, product_c = box.band, simulated.product_c
     if band is None or product_c is None:
         return None
-    check = check_cold_chain(band, product_c, PLAN_DT_S)
+    check = box_check(band, simulated, PLAN_DT_S)
     stop = None
     if check.first_break_step is not None:
-        sample = check.first_break_step + 1  # the step's end
+        sample = check.first_break_step + 1  # the step's end (before departure: the start)
         stop = next((name for leave, name in leaving if leave >= sample), None)
-    return ColdChainResult.of(band, check, PLAN_DT_S, stop)
+    return ColdChainResult.of(band, check, stop)
+
+
+def deliveries(
+    box: CargoBoxParams, simulated: BoxResult, handed_over: Sequence[int]
+) -> list[DeliveredGoods] | None:
+    """The goods handed over at each of the samples ``handed_over`` (a stop's departure): their
+    warmest and their minutes above the band from their loading on, and whether the chain
+    had broken by then (None: no product)."""
+    band, trace = box.band, simulated.product_c
+    if band is None or trace is None:
+        return None
+    check = box_check(band, simulated, PLAN_DT_S)
+    product_c, seconds, before = goods_history(trace, PLAN_DT_S, simulated.goods_before)
+    warmest = np.fmax.accumulate(product_c)
+    above = np.cumsum(np.where(product_c > band.max_c + 1e-9, seconds, 0.0)) / 60.0
+    broke = math.inf if check.first_break_step is None else check.first_break_step
+    out = []
+    for sample in handed_over:
+        last = before + max(sample, 1) - 1  # sample i ends step i − 1
+        out.append(
+            DeliveredGoods(
+                product_max_c=float(warmest[last]) if math.isfinite(warmest[last]) else None,
+                minutes_above_band=float(above[last]),
+                verdict="breaks" if broke <= sample - 1 else "holds",
+            )
+        )
+    return out
 
 
 def refrigeration(
@@ -63,7 +92,7 @@ def refrigeration(
     box = simulated.box
     power = simulated.power_w["refrigeration"]
     on_battery = 1.0 - simulated.plugged
-    thermostat = power if box.thermostat_power_w is None else box.thermostat_power_w
+    thermostat = power if box.thermostat is None else box.thermostat.power_w
     setpoint = (
         np.full(power.shape, van.cargo_box.setpoint_c) if box.setpoint_c is None else box.setpoint_c
     )
@@ -104,4 +133,51 @@ def refrigeration(
         cost=cost(battery_kwh, power, precool_kwh),
         thermostat_cost=cost(thermostat_kwh, thermostat, 0.0),
         schedule=schedule,
+        followed=box.followed,
+        baselines=[] if box.best_constant is None else baselines(van, simulated, kwh, cost),
     )
+
+
+def baselines(
+    van: VanParams,
+    simulated: SimulationResult,
+    kwh: Callable[[FloatArray, FloatArray], float],
+    cost: Callable[[float, FloatArray, float], float | None],
+) -> list[Baseline]:
+    """The configured thermostat's day and the best constant set-point's beside the unit's
+    (``kwh``: energy of a power over a share of each step; ``cost``: of the battery's energy,
+    a power on the grid and pre-cooling)."""
+    box, band = simulated.box, van.cargo_box.band
+    assert box.best_constant is not None and band is not None  # a box with a product
+    power = simulated.power_w["refrigeration"]
+    on_battery = 1.0 - simulated.plugged
+    battery = kwh(power, on_battery)
+    total = battery + kwh(power, simulated.plugged) + box.precool_grid_j / JOULES_PER_KWH
+    constant = box.best_constant()
+    out = []
+    for name, setpoint_c, result in (
+        ("thermostat", van.cargo_box.setpoint_c, box.thermostat or box),
+        ("best-constant", constant.setpoint_c, constant.box),
+    ):
+        watts = result.power_w
+        its_battery, its_grid = kwh(watts, on_battery), kwh(watts, simulated.plugged)
+        assert result.product_c is not None  # a box with a product
+        holds = box.unheld is None and box_check(band, result, PLAN_DT_S).holds
+        out.append(
+            Baseline(
+                name=name,
+                setpoint_c=setpoint_c,
+                battery_kwh=its_battery,
+                grid_kwh=its_grid,
+                cost=cost(its_battery, watts, 0.0),
+                cold_chain="holds" if holds else "breaks",
+                battery_saved=_saved(battery, its_battery),
+                total_saved=_saved(total, its_battery + its_grid),
+            )
+        )
+    return out
+
+
+def _saved(used: float, baseline: float) -> float:
+    """The share of ``baseline`` that ``used`` does without [–]."""
+    return 1.0 - used / baseline if baseline > 0 else 0.0

@@ -20,7 +20,7 @@ from core.params import Location, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.cycles import trace_distance_m
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate
-from core.planning.day.box import cold_chain, refrigeration, temperatures
+from core.planning.day.box import cold_chain, deliveries, refrigeration, temperatures
 from core.planning.day.scene import Scene, charge_points
 from core.planning.day.start_state import box_start_c, product_start_c, start_payload_kg
 from core.planning.day.timeline import (
@@ -204,6 +204,16 @@ class _Split:
         out = []
         payload = start_payload_kg(self.problem)
         reloads = set(self.timeline.reloaded_at)
+        goods = deliveries(
+            self.problem.van.cargo_box,
+            self.simulated.box,
+            [
+                int(self.timeline.leave[k])
+                for k in range(len(self.order) - 2)
+                if self.itinerary.kind(k + 1, len(self.problem.stops)) == "stop"
+            ],
+        )
+        handed = iter(goods or [])
         for k, j in enumerate(self.order[1:-1]):
             if k + 1 in reloads:
                 payload = self.problem.van.payload_kg
@@ -233,6 +243,7 @@ class _Split:
                         if self.simulated.box.product_c is None
                         else temperatures(self.simulated.box.product_c, b, c)
                     ),
+                    goods=next(handed, None),
                 )
             )
         return out

@@ -26,7 +26,7 @@ from core.clock import departure
 from core.exceptions import CoreError, InvalidParameterError, ServiceUnavailableError
 from core.params import Location, Stop, VanParams, plain_rule, product_band
 from core.physics.battery import BatteryVerdict
-from core.physics.cold_chain import check_cold_chain
+from core.physics.cold_chain import box_check
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
 from core.physics.weather import HourlyWeather, WeatherService
 from core.planning.day.scene import legs_for, round_places
@@ -427,7 +427,7 @@ def _day(
     date: dt.date, van: VanParams, result: SimulationResult, chargers: Sequence[ChargeOption]
 ) -> DayOutcome:
     band, product_c = van.cargo_box.band, result.box.product_c
-    holds = band is None or product_c is None or check_cold_chain(band, product_c, PLAN_DT_S).holds
+    holds = band is None or product_c is None or box_check(band, result.box, PLAN_DT_S).holds
     return DayOutcome(
         date=date,
         energy_kwh={

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from core.params import PRODUCT_CLASSES, CargoBoxParams, ProductBand, RefrigerationStrategy
-from core.physics.cold_chain import Run, box_with_goods, check_cold_chain
+from core.physics.cold_chain import Run, box_check, box_with_goods, check_cold_chain
 
 HOUR = 3600
 DAIRY = CargoBoxParams(product="chilled-dairy", load_temperature_c=5.0)  # set-point 3 °C
@@ -114,3 +114,62 @@ def test_a_band_and_a_class_set_the_air_set_point_and_refuse_one_outside():
         ProductBand(min_c=5.0, max_c=1.0)
     with pytest.raises(ValueError, match="subnormal"):
         ProductBand(min_c=1e-320, max_c=1.0)
+
+
+def test_a_rise_within_the_brief_rise_breaks_once_it_lasts_longer_than_the_rules_allow():
+    # frozen goods 2 K above −18 °C: within the 3 K of 89/108/EEC, but for two hours of one-
+    # minute steps it breaks once the rise has lasted its 30 minutes (the 31st minute above);
+    # twenty minutes of it hold, twice over with a return to the band between
+    frozen = PRODUCT_CLASSES["frozen"]
+    assert frozen.excursion_minutes == 30.0
+    long_rise = np.array([-20.0] * 60 + [-16.0] * 120 + [-20.0] * 60)
+    check = check_cold_chain(frozen, long_rise, 60.0)
+    assert not check.holds and check.first_break_step == 60 + 30
+    assert check.first_break_s == pytest.approx(91 * 60.0)
+    assert "longer than the brief rise the rules allow (30 min)" in (check.reason or "")
+    assert check.minutes_outside_band == pytest.approx(120.0)
+    brief = np.array(([-20.0] * 30 + [-16.0] * 20) * 2 + [-20.0] * 30)
+    held = check_cold_chain(frozen, brief, 60.0)
+    assert held.holds and held.minutes_outside_band == pytest.approx(40.0)
+    # a product may say how brief: 10 minutes, and the twenty break
+    strict = frozen.model_copy(update={"excursion_minutes": 10.0})
+    assert check_cold_chain(strict, brief, 60.0).first_break_step == 30 + 10
+
+
+def test_goods_loaded_outside_their_band_break_it_from_loading():
+    # dairy (0–6 °C) loaded at 12 °C and cooled into the band within the first hour: the
+    # verdict breaks as loaded, before the trace's first step, and the warmest is 12 °C
+    dairy = PRODUCT_CLASSES["chilled-dairy"]
+    trace = np.linspace(11.0, 4.0, 60)
+    loaded = (np.array([12.0]), np.array([0.0]))
+    check = check_cold_chain(dairy, trace, 60.0, loaded)
+    assert not check.holds and check.first_break_step == -1 and check.first_break_s == 0.0
+    assert check.product_max_c == 12.0
+    assert check.reason == (
+        "the goods reached 12.0 °C before departure (as loaded or at the depot), above "
+        "their band's 6 °C"
+    )
+    # loaded at −2 °C, below the floor: broken too, and the box warns of it
+    frozen_milk = check_cold_chain(dairy, np.full(60, 3.0), 60.0, (np.array([-2.0]), np.zeros(1)))
+    assert not frozen_milk.holds and "below their band's floor of 0 °C" in frozen_milk.reason
+    cold = run(DAIRY.model_copy(update={"load_temperature_c": -2.0}), 0.5)
+    assert any("loaded at -2 °C, below their band's floor" in note for note in cold.notes)
+    assert not check_cold_chain(dairy, cold.product_c, 1.0, cold.goods_before).holds
+
+
+def test_a_steady_box_whose_unit_is_too_weak_for_the_band_breaks_and_says_why():
+    # the paper's box (K = 2.172 W/(m²·K), 30.6 m², a 3 kW unit) with frozen goods at 35 °C:
+    # the walls alone bring 2.172 × 30.604 × (35 + 18) ≈ 3,523 W at the band's ceiling — the
+    # steady box assumes the unit removes it, so the verdict breaks, from the first step,
+    # with the unit's shortfall
+    frozen = CargoBoxParams(product="frozen", load_temperature_c=-24.0)
+    assert frozen.mode == "steady" and frozen.refrigeration_capacity_w == 3000.0
+    weak = run(frozen, 1.0, ambient_c=35.0)
+    assert weak.unheld is not None and weak.unheld[0] == 0
+    assert "3.0 kW cannot hold the goods' band" in weak.unheld[1] and "3.5 kW" in weak.unheld[1]
+    assert weak.unheld[1] in weak.notes
+    check = box_check(PRODUCT_CLASSES["frozen"], weak, 1.0)
+    assert not check.holds and check.reason == weak.unheld[1]
+    # 4 kW holds it
+    strong = run(frozen.model_copy(update={"refrigeration_capacity_w": 4000.0}), 1.0, 35.0)
+    assert strong.unheld is None and box_check(PRODUCT_CLASSES["frozen"], strong, 1.0).holds

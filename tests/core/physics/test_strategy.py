@@ -13,10 +13,17 @@ import math
 import numpy as np
 import pytest
 
-from core.params import PRODUCT_CLASSES, CargoBoxParams, RefrigerationStrategy, get_preset
-from core.physics.cargo import air_heat_capacity_j_k
+from core.params import (
+    PRODUCT_CLASSES,
+    CargoBoxParams,
+    ProductBand,
+    RefrigerationStrategy,
+    get_preset,
+)
+from core.physics.cargo import air_heat_capacity_j_k, refrigeration_cop
 from core.physics.cold_chain import (
     Run,
+    _constant,
     _flows,
     box_with_goods,
     check_cold_chain,
@@ -25,7 +32,7 @@ from core.physics.cold_chain import (
     plan_setpoints,
     two_nodes,
 )
-from core.physics.strategy import MARGIN_K
+from core.physics.strategy import margin_k
 
 HOUR = 3600
 THERMOSTAT = RefrigerationStrategy()
@@ -71,13 +78,27 @@ def test_an_empty_box_is_let_warm_to_its_bands_ceiling_and_held_there():
     assert ratio == pytest.approx(by_hand, abs=0.005)
 
 
+#: The summer day's stops: 30 of 2-minute doors, 940 s apart.
+STOPS = 600 + np.arange(30) * 940
+
+
+def summer_payload(n: int):
+    """500 kg delivered evenly at the summer day's stops."""
+    delivered = np.searchsorted(STOPS + 120, np.arange(n), side="right")
+    return 500.0 * (1.0 - delivered / 30)
+
+
+def summer_doors(n: int):
+    door = np.zeros(n)
+    for t in STOPS:
+        door[t : t + 120] = 1.0
+    return door
+
+
 def summer_day(box, strategy):
     """30 stops of 2-minute doors 940 s apart, 500 kg delivered evenly, 30 °C, 250 W of sun."""
     n = 8 * HOUR
-    stops = 600 + np.arange(30) * 940
-    delivered = np.searchsorted(stops + 120, np.arange(n), side="right")
-    payload = 500.0 * (1.0 - delivered / 30)
-    return day(box, strategy, payload=payload, doors=stops.tolist(), sun=250.0)
+    return day(box, strategy, payload=summer_payload(n), doors=STOPS.tolist(), sun=250.0)
 
 
 def test_the_goods_mass_and_pre_cooling_spare_the_battery_inside_the_band():
@@ -95,9 +116,9 @@ def test_the_goods_mass_and_pre_cooling_spare_the_battery_inside_the_band():
     assert results[0.0].precool_grid_j == 0.0 < results[60.0].precool_grid_j
     for result in results.values():
         check = check_cold_chain(band, result.product_c, 1.0)
-        assert check.holds and check.product_max_c <= band.max_c - MARGIN_K + 0.05
+        assert check.holds and check.product_max_c <= band.max_c - margin_k(band) + 0.05
         # the thermostat's draw on the same day rides along for the answer's comparison
-        assert result.thermostat_power_w == pytest.approx(thermostat.power_w)
+        assert result.thermostat.power_w == pytest.approx(thermostat.power_w)
 
 
 def test_the_simulation_follows_the_programmes_schedule():
@@ -109,10 +130,17 @@ def test_the_simulation_follows_the_programmes_schedule():
     minute_ends = np.arange(59, 8 * HOUR, 60)
     gap = np.abs(result.temperature_c[minute_ends] - result.setpoint_c[minute_ends])
     assert np.median(gap) < 0.05
-    # the air floats within the band and is pulled down before the doors open
+    # the air floats within the band — but while a door is open (give or take the
+    # programme's minute), when it may rise: the goods are what is held; after a door the
+    # unit at its capacity needs some minutes more (the air's bound is soft)
     assert box.band is not None
+    shut = np.ones(8 * HOUR, dtype=bool)
+    for t in STOPS:
+        shut[t - 60 : t + 120 + 60] = False
     assert result.setpoint_c.min() >= box.band.min_c - 1e-6
-    assert result.setpoint_c.max() <= box.band.max_c + 1e-6
+    assert np.quantile(result.setpoint_c[shut], 0.95) <= box.band.max_c + 1e-6
+    assert result.setpoint_c[shut].max() <= box.band.max_c + 0.5
+    assert result.setpoint_c[~shut].max() > box.band.max_c  # and it does
 
 
 def test_a_winter_day_keeps_chilled_goods_above_their_floor_with_the_heater():
@@ -120,9 +148,9 @@ def test_a_winter_day_keeps_chilled_goods_above_their_floor_with_the_heater():
     band = PRODUCT_CLASSES["chilled-dairy"]
     result = day(box, OPTIMAL, ambient=-15.0, payload=np.full(6 * HOUR, 500.0), hours=6.0)
     check = check_cold_chain(band, result.product_c, 1.0)
-    assert check.holds and check.product_min_c >= band.min_c + MARGIN_K - 0.05
+    assert check.holds and check.product_min_c >= band.min_c + margin_k(band) - 0.05
     # heating less than the thermostat: the air is let cool towards the floor, not held at 3
-    assert result.power_w.sum() < result.thermostat_power_w.sum()
+    assert result.power_w.sum() < result.thermostat.power_w.sum()
 
 
 def test_a_day_the_unit_cannot_hold_is_answered_with_the_band_broken():
@@ -210,4 +238,99 @@ def test_days_on_the_road_are_planned_on_a_coarser_grid_and_still_hold():
     optimal = box_with_goods(box, outside, payload, 60.0, start, Run(OPTIMAL, np.zeros(n)))
     check = check_cold_chain(PRODUCT_CLASSES["chilled-dairy"], optimal.product_c, 60.0)
     assert check.holds
-    assert optimal.power_w.sum() < optimal.thermostat_power_w.sum()
+    assert optimal.power_w.sum() < optimal.thermostat.power_w.sum()
+
+
+# --- the fair baseline: the best constant set-point ----------------------------------------
+
+
+def battery_kwh(result) -> float:
+    return float(result.power_w.sum()) / 3.6e6  # 1 s steps, nothing plugged in
+
+
+def kept_in(band, product_c) -> bool:
+    """The goods as far inside their band as the strategy keeps them (its margin)."""
+    return bool(
+        np.nanmax(product_c) <= band.max_c - margin_k(band) + 1e-9
+        and np.nanmin(product_c) >= band.min_c + margin_k(band) - 1e-9
+    )
+
+
+def test_the_best_constant_set_point_is_the_cheapest_that_keeps_the_goods_in_band():
+    # every set-point in dairy's band a quarter kelvin apart, each followed at full resolution
+    # from a box pre-conditioned to it: none that keeps the goods in band (as far inside as
+    # the strategy keeps them) draws less than the one the search found (within the
+    # search's tenth of a kelvin), and a tenth of a kelvin warmer it would not keep them
+    box = reference_box()
+    band = PRODUCT_CLASSES["chilled-dairy"]
+    n = 8 * HOUR
+    thermostat = summer_day(box, THERMOSTAT)
+    best = thermostat.best_constant()
+    found = battery_kwh(best.box)
+    assert kept_in(band, best.box.product_c)
+    outside = (np.full(n, 30.0), np.full(n, 250.0), summer_doors(n))
+    payload = summer_payload(n)
+    for setpoint in np.arange(band.min_c, band.max_c + 1e-9, 0.25):
+        start = (float(setpoint), box.load_c)
+        kept = follow(box, outside, payload, 1.0, _constant(float(setpoint), payload, start))
+        if kept_in(band, kept.product_c):
+            assert battery_kwh(kept) >= found * (1 - 2e-3), setpoint
+    if best.setpoint_c + 0.1 <= band.max_c:
+        warmer_c = best.setpoint_c + 0.1
+        constant = _constant(warmer_c, payload, (warmer_c, box.load_c))
+        assert not kept_in(band, follow(box, outside, payload, 1.0, constant).product_c)
+    # the configured thermostat at the band's middle draws more than the best constant
+    assert battery_kwh(thermostat) > found
+
+
+@pytest.mark.parametrize("product", ["chilled-dairy", "frozen"])
+def test_the_optimal_strategy_never_draws_more_than_the_best_constant(product):
+    # the hot day with chilled and frozen goods: whatever the programme plans, the unit draws
+    # no more from the battery than the best constant set-point, and follows the set-point
+    # where the schedule would not beat it
+    load, setpoint = {"chilled-dairy": (4.0, 3.0), "frozen": (-22.0, -24.0)}[product]
+    box = reference_box(product=product, load_temperature_c=load, setpoint_c=setpoint)
+    optimal = summer_day(box, RefrigerationStrategy(strategy="optimal"))
+    best = optimal.best_constant()
+    assert battery_kwh(optimal) <= battery_kwh(best.box) + 1e-9
+    assert optimal.followed in ("schedule", "best-constant")
+    if optimal.followed == "best-constant":
+        assert optimal.setpoint_c == pytest.approx(best.setpoint_c)
+
+
+def test_pre_cooling_is_counted_at_the_air_it_reaches_without_credit():
+    # the depot's hour from the programme's own air and goods: the heat the unit removed by
+    # the energy balance of each step (walls, the air's and the goods' heat given up), over
+    # the COP at the air reached, plus the standby draw: what the answer reports, within 2 %
+    box = reference_box()
+    n = 8 * HOUR
+    payload = summer_payload(n)
+    outside = (np.full(n, 30.0), np.full(n, 250.0), summer_doors(n))
+    start = (box.setpoint_c, box.load_c)
+    run = Run(RefrigerationStrategy(strategy="optimal"), np.zeros(n))
+    planned = plan_setpoints(box, outside, payload, 1.0, start, run)
+    air = np.concatenate(([start[0]], planned.depot_air_c))
+    goods = np.concatenate(([start[1]], planned.depot_product_c))
+    seconds = planned.depot_seconds_s
+    assert seconds.sum() == pytest.approx(3600.0)
+    walls_w = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2 * (30.0 - air[1:])
+    stored_j = air_heat_capacity_j_k(box) * -np.diff(air)
+    stored_j += 500.0 * box.cargo_specific_heat_j_kgk * -np.diff(goods)
+    removed_w = walls_w + stored_j / seconds
+    assert removed_w.min() >= -1e-6  # it cools only
+    cop = refrigeration_cop(box, 30.0, air[1:])
+    by_hand_j = float(((removed_w / cop + box.standby_power_w) * seconds).sum())
+    assert planned.precool_grid_j == pytest.approx(by_hand_j, rel=0.02)
+    # priced at the set-point's COP, as the programme first did, it would be less
+    at_setpoint_j = float(((removed_w / refrigeration_cop(box, 30.0, 3.0)) * seconds).sum())
+    assert at_setpoint_j < planned.precool_grid_j
+
+
+def test_a_band_too_narrow_to_plan_in_falls_back_to_the_thermostat_and_says_so():
+    narrow = ProductBand(min_c=2.0, max_c=2.8)
+    box = reference_box(product=narrow, load_temperature_c=2.4, setpoint_c=2.4)
+    optimal = summer_day(box, RefrigerationStrategy(strategy="optimal"))
+    thermostat = summer_day(box, THERMOSTAT)
+    assert optimal.followed == "thermostat" and optimal.power_w == pytest.approx(thermostat.power_w)
+    assert any("narrower than the optimal strategy plans in" in n for n in optimal.notes)
+    assert not any("narrower" in n for n in thermostat.notes)
