@@ -10,14 +10,17 @@ spells, per second) are taken as the plan's simulation hands them to
   of :data:`core.physics.cold_chain.BOX_STEP_S` (the physics' own step) instead of the
   strategy's minute, both schedules followed by the full physics: the battery energy of the
   plan's schedule over the fine one's;
-* **1,000 disturbed replays** — each stop's door open ±50 % (uniform) and its arrival moved
-  around the plan (a random walk of σ :data:`ARRIVAL_STEP_S` per stop, within
-  ±:data:`ARRIVAL_S`); the outside at the replay's clock. The optimal strategy departs with
-  the plan's schedule and is re-planned at each stop from the box's actual state (air and
-  goods) over the rest of the plan — :func:`core.physics.cold_chain.plan_setpoints` from a
-  start under way, what a plan from ``start_state`` runs for the box; the thermostat holds
-  its set-point. The share of replays whose goods stayed inside their band
-  (:func:`core.physics.cold_chain.check_cold_chain`, the answer's verdict) for each.
+* **:data:`REPLAYS` disturbed replays** of the hot chilled and the hot frozen day — each
+  stop's door open ±50 % (uniform), its arrival moved around the plan (a random walk of σ
+  :data:`ARRIVAL_STEP_S` per stop, within ±:data:`ARRIVAL_S`), the day :data:`AMBIENT_K`
+  warmer than its forecast. The optimal strategy departs with the plan's choice and is
+  re-planned at each stop from the box's actual state (air and goods) over the rest of the
+  plan — :func:`core.physics.cold_chain.plan_unit` from a start under way, what a plan from
+  ``start_state`` runs for the box: the schedule, or the best constant set-point where that
+  is better; the thermostat holds its set-point. The share of replays whose goods stayed
+  inside their band for each, and whether the verdict
+  (:func:`core.physics.cold_chain.check_cold_chain`, the answer's) agreed with the
+  temperatures in every one.
 """
 
 from __future__ import annotations

@@ -14,8 +14,8 @@ from app.schemas.base import ColdChainOut, ConsumptionWhPerKm, PowerSeries
 from app.schemas.simulate import Series, SimulateRequest, SimulateResponse
 from app.settings import Settings
 from core.arrays import FloatArray
-from core.exceptions import LimitExceededError
-from core.params import STREET_TYPES, CargoBoxParams
+from core.exceptions import InvalidParameterError, LimitExceededError
+from core.params import STREET_TYPES, CargoBoxParams, VanParams
 from core.physics.cargo import BoxResult
 from core.physics.cold_chain import box_check
 from core.physics.cycles import generate_leg
@@ -57,6 +57,7 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
             "speed_mps" if request.cycle is None else "cycle.distance_m",
         )
     check_trace(speed, request.dt_s)  # at least 2 samples; before asking for the weather
+    _check_replay(request, van)
     van.cargo_box.check_day((speed.size - 1) * request.dt_s)
     forecast, warnings = forecast_for(
         request.weather,
@@ -76,6 +77,7 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
         weather=forecast,
         door_openings=request.door_openings,
         parked=request.parked,
+        air_setpoints=request.air_setpoints,
     )
     km = result.distance_m / 1000
     # Per-km figures of a trace that (nearly) stands still mean nothing: null below a metre.
@@ -116,6 +118,23 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
         grid_kwh=result.grid_kwh,
         warnings=[*warnings, *result.warnings],
     )
+
+
+def _check_replay(request: SimulateRequest, van: VanParams) -> None:
+    """A schedule to replay needs goods to hold and no strategy of its own."""
+    if not request.air_setpoints:
+        return
+    if van.cargo_box.product is None:
+        raise InvalidParameterError(
+            "air_setpoints replays a schedule on the goods: it needs cargo_box.product",
+            "air_setpoints",
+        )
+    if van.refrigeration.strategy != "thermostat":
+        raise InvalidParameterError(
+            "air_setpoints is a schedule to follow, refrigeration.strategy 'optimal' one to "
+            "plan: send one of them",
+            "air_setpoints",
+        )
 
 
 def _at_samples(per_step: FloatArray) -> list[Any]:

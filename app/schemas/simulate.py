@@ -28,6 +28,7 @@ from core.params import (
     Interval,
     IsoDateTime,
     Location,
+    SetpointSpan,
     StreetTypeName,
     TrafficDensity,
     Weather,
@@ -82,6 +83,15 @@ class SimulateRequest(VanRequest):
         max_length=MAX_INTERVALS,
         description="When the van stands at a stop, seconds after the start: the cab HVAC's "
         "duty while parked (vehicle.cab_hvac_at_stops).",
+    )
+    air_setpoints: list[SetpointSpan] = Field(
+        default_factory=list,
+        max_length=MAX_INTERVALS,
+        description="A refrigeration schedule to replay instead of the strategy: the air "
+        "set-point from start_s for duration_s, seconds after the start, in time order and "
+        "not overlapping (a plan's refrigeration.schedule, against the day as it went: its "
+        "doors, its weather); outside the spans the unit holds cargo_box.setpoint_c. Needs "
+        "cargo_box.product and the thermostat strategy.",
     )
     include_series: bool = Field(False, description="Return the time series too.")
 

@@ -52,6 +52,15 @@ class DoorOpening(Interval):
     duration_s: float = Field(..., ge=0, le=86_400, description="How long it stays open [s].")
 
 
+class SetpointSpan(Interval):
+    """A stretch of a refrigeration unit's schedule to follow: its air set-point from
+    ``start_s`` for ``duration_s`` (a plan's ``refrigeration.schedule``, in seconds)."""
+
+    air_setpoint_c: float = Field(
+        ..., ge=-60, le=30, description="The air set-point the unit follows [°C]."
+    )
+
+
 class ChargingSpell(Interval):
     """A spell plugged in at a charger during a simulated trace (the van stands)."""
 

@@ -226,14 +226,16 @@ def _integrate(
 class Run:
     """How the unit runs: its strategy, the share of each step the van is plugged in (its
     consumers on the grid) and that share times the price there [per kWh], whether it leaves
-    the depot (the optimal strategy may pre-cool there), and the battery's charging
-    efficiency (what refilling a kWh costs)."""
+    the depot (the optimal strategy may pre-cool there), the battery's charging efficiency
+    (what refilling a kWh costs), and a schedule to follow instead of the strategy (the air
+    set-point of each step [°C], NaN: the thermostat's; a plan's, replayed)."""
 
     strategy: RefrigerationStrategy
     plugged: FloatArray
     from_depot: bool = True
     priced: FloatArray | None = None
     charging_efficiency: float = 1.0
+    setpoint_c: FloatArray | None = None
 
     def weights(self) -> tuple[FloatArray, float]:
         """What a joule drawn in each step weighs in the strategy's objective, against one
@@ -297,6 +299,23 @@ def box_with_goods(
     )
     # a steady box is held by assumption: only the rating says the unit cannot
     held = unheld if box.mode == "steady" else None
+    if run.setpoint_c is not None:  # a schedule given: followed, the heater holding the floor
+        assert box.band is not None  # a box with a product
+        given = ~np.isnan(run.setpoint_c)
+        cool_to = np.where(given, run.setpoint_c, box.setpoint_c)
+        heat_to = np.where(given, np.minimum(cool_to, box.band.min_c), box.setpoint_c)
+        replayed = follow(box, outside, payload_kg, dt_s, Setpoints(cool_to, heat_to, start_c))
+        return replace(
+            replayed,
+            setpoint_c=cool_to,
+            product_before_c=loaded,
+            seconds_before_s=np.zeros(1),
+            followed="schedule",
+            thermostat=kept,
+            best_constant=functools.cache(functools.partial(best_constant, box, day)),
+            unheld=held,
+            notes=notes,
+        )
     narrow = _too_narrow(box) if run.strategy.strategy == "optimal" else ()
     if run.strategy.strategy == "thermostat" or narrow:
         return replace(

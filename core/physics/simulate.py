@@ -8,6 +8,7 @@ samples has ``n − 1`` steps; per-step arrays hold the mean power over each ste
 from __future__ import annotations
 
 import datetime as dt
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -25,6 +26,7 @@ from core.params import (
     DoorOpening,
     Interval,
     Location,
+    SetpointSpan,
     VanParams,
     Weather,
 )
@@ -244,6 +246,7 @@ def simulate(
     charging: Sequence[ChargingSpell] = (),
     box_start_c: float | None = None,
     product_start_c: float | None = None,
+    air_setpoints: Sequence[SetpointSpan] = (),
 ) -> SimulationResult:
     """Simulate every consumer of the van along one speed trace (paper Fig. 7, one leg).
 
@@ -286,13 +289,23 @@ def simulate(
     product_start_c
         With a product in the box: the goods' temperature at the start [°C]; None: as loaded
         (``cargo_box.load_temperature_c``).
+    air_setpoints
+        With a product in the box: a schedule for the unit to follow instead of its strategy
+        (a plan's, replayed against the day as it went), seconds after the start, in order
+        and not overlapping; outside its spans the unit holds ``cargo_box.setpoint_c``.
 
     Returns
     -------
     SimulationResult
     """
     trace = _driven(
-        van, speed_mps, dt_s, grade, payload_kg, door_openings, parked, heading_deg, charging
+        van,
+        speed_mps,
+        dt_s,
+        grade,
+        payload_kg,
+        (door_openings, parked, charging, air_setpoints),
+        heading_deg,
     )
     n = trace.speed.size
     check_representable(start, (n - 1) * dt_s)
@@ -360,6 +373,7 @@ class _Trace:
     warnings: list[str]
     charging: Sequence[ChargingSpell] = ()
     asked_s: FloatArray | None = None
+    air_setpoints: Sequence[SetpointSpan] = ()
 
 
 def _driven(
@@ -368,10 +382,10 @@ def _driven(
     dt_s: float,
     grade: ArrayLike,
     payload_kg: ArrayLike | None,
-    door_openings: Sequence[DoorOpening],
-    parked: Sequence[Interval],
+    spans: tuple[
+        Sequence[DoorOpening], Sequence[Interval], Sequence[ChargingSpell], Sequence[SetpointSpan]
+    ],
     heading_deg: ArrayLike | None,
-    charging: Sequence[ChargingSpell] = (),
 ) -> _Trace:
     """The inputs checked, and the trace the van drives: the one asked for, or — when it asks
     for more than the motor's cap — the slower one the van can drive
@@ -382,13 +396,29 @@ def _driven(
     payload = van.payload_kg if payload_kg is None else payload_kg
     grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
     payload_step = _per_step(payload, n, "payload_kg", 0.0, MAX_PAYLOAD_KG)
-    _check_within((n - 1) * dt_s, door_openings=door_openings, parked=parked, charging=charging)
+    door_openings, parked, charging, air_setpoints = spans
+    _check_within(
+        (n - 1) * dt_s,
+        door_openings=door_openings,
+        parked=parked,
+        charging=charging,
+        air_setpoints=air_setpoints,
+    )
+    _check_in_order(air_setpoints)
     retimed = power_limited(
         van.vehicle, speed, dt_s, van.vehicle.mass_kg + payload_step, grade_step
     )
     if retimed is None:
         return _Trace(
-            speed, grade_step, payload_step, heading_deg, door_openings, parked, [], charging
+            speed,
+            grade_step,
+            payload_step,
+            heading_deg,
+            door_openings,
+            parked,
+            [],
+            charging,
+            air_setpoints=air_setpoints,
         )
     m = retimed.speed_mps.size
     at = retimed.original_s / dt_s  # where each new sample lies in the original's samples
@@ -418,6 +448,7 @@ def _driven(
         ],
         [moved(c) for c in charging],
         retimed.original_s,
+        [moved(a) for a in air_setpoints],
     )
 
 
@@ -462,6 +493,7 @@ def _consumers(
                 initial_c is None,
                 plugged_share(trace.charging, n_steps, dt_s, priced=True),
                 van.battery.charging_efficiency,
+                schedule_c(trace.air_setpoints, n_steps, dt_s) if trace.air_setpoints else None,
             ),
         )
     cab_gap_j = 0.0 if box_start_c is not None else _cab_gap_j(van, outside.start_c)
@@ -572,6 +604,30 @@ def _headwind_mps(
     return headwind_mps(
         outside.wind_from_east_mps, outside.wind_from_north_mps, _step_heading(heading_deg, n)
     )
+
+
+def _check_in_order(spans: Sequence[SetpointSpan]) -> None:
+    """A schedule's spans in time order, none overlapping the one before."""
+    for index, (before, span) in enumerate(itertools.pairwise(spans), start=1):
+        if span.start_s < before.start_s + before.duration_s:
+            raise InvalidParameterError(
+                f"air_setpoints[{index}] starts at {span.start_s:g} s, before the span before "
+                f"it ends ({before.start_s + before.duration_s:g} s): spans in time order, "
+                "none overlapping",
+                f"air_setpoints[{index}].start_s",
+            )
+
+
+def schedule_c(spans: Sequence[SetpointSpan], n_steps: int, dt_s: float) -> FloatArray:
+    """The air set-point of each step [°C] from a schedule's spans (in order): the span's at
+    the step's middle, NaN outside every span."""
+    middle_s = (np.arange(n_steps) + 0.5) * dt_s
+    starts = np.array([span.start_s for span in spans])
+    ends = starts + np.array([span.duration_s for span in spans])
+    values = np.array([span.air_setpoint_c for span in spans])
+    at = np.searchsorted(starts, middle_s, side="right") - 1
+    inside = (at >= 0) & (middle_s < ends[np.maximum(at, 0)])
+    return np.where(inside, values[np.maximum(at, 0)], np.nan)
 
 
 def _check_within(end_s: float, **intervals: Sequence[Interval]) -> None:

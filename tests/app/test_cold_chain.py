@@ -453,3 +453,113 @@ def test_frozen_goods_in_the_papers_steady_box_on_a_hot_day_break_for_want_of_ca
     chain = data["cold_chain"]
     assert chain["verdict"] == "breaks" and "3.0 kW cannot hold the goods' band" in chain["reason"]
     assert chain["reason"] in data["warnings"]
+
+
+# --- a schedule replayed against the day as it went ---------------------------------------
+
+REPLAY_BOX = DYNAMIC | {"product": "chilled-dairy", "load_temperature_c": 4.0}
+
+
+def _replay(spans: list[dict[str, float]], **changes: Any) -> dict[str, Any]:
+    from app.examples import SIMULATE_EXAMPLE
+
+    return SIMULATE_EXAMPLE | {"cargo_box": REPLAY_BOX, "air_setpoints": spans} | changes
+
+
+def test_a_schedule_replayed_is_followed_span_by_span(client):
+    # one span at 5 °C over the whole trace from a box at 5 °C: the unit as a thermostat at
+    # 5 °C (nothing to heat on a summer day), the same energy and goods; two spans: each
+    # sample's set-point is its span's, and the configured set-point outside them
+    whole = client.post("/v1/simulate", json=_replay([], include_series=True)).json()
+    end_s = whole["duration_s"]
+    at_five_box = REPLAY_BOX | {"setpoint_c": 5.0}
+    replayed = client.post(
+        "/v1/simulate",
+        json=_replay(
+            [{"start_s": 0, "duration_s": end_s, "air_setpoint_c": 5.0}], cargo_box=at_five_box
+        ),
+    ).json()
+    at_five = client.post("/v1/simulate", json=_replay([], cargo_box=at_five_box)).json()
+    assert replayed["energy_kwh"]["refrigeration"] == pytest.approx(
+        at_five["energy_kwh"]["refrigeration"], rel=1e-9
+    )
+    assert replayed["cold_chain"] == at_five["cold_chain"]
+    spans = [
+        {"start_s": 100, "duration_s": 200, "air_setpoint_c": 1.5},
+        {"start_s": 300, "duration_s": 100, "air_setpoint_c": 5.5},
+    ]
+    series = client.post("/v1/simulate", json=_replay(spans, include_series=True)).json()["series"]
+    for t, setpoint in zip(series["time_s"], series["air_setpoint_c"], strict=True):
+        middle = t - 0.5  # the step ending at sample t
+        expected = 1.5 if 100 <= middle < 300 else 5.5 if 300 <= middle < 400 else 3.0
+        if t > 0:
+            assert setpoint == pytest.approx(expected), t
+    # a warmer schedule draws less than the thermostat at the band's middle
+    warm = [{"start_s": 0, "duration_s": end_s, "air_setpoint_c": 6.0}]
+    assert (
+        client.post("/v1/simulate", json=_replay(warm)).json()["energy_kwh"]["refrigeration"]
+        < whole["energy_kwh"]["refrigeration"]
+    )
+
+
+def test_a_schedule_replayed_on_a_worse_day_says_what_the_goods_went_through(client):
+    # the band's top all day, and then the door stands open for 20 minutes at 31 °C with a
+    # 1 kW unit: the goods leave dairy's 6 °C and the verdict says so
+    weak = REPLAY_BOX | {"refrigeration_capacity_w": 1000.0, "load_temperature_c": 5.9}
+    body = _replay(
+        [{"start_s": 0, "duration_s": 600, "air_setpoint_c": 6.0}],
+        cargo_box=weak,
+        door_openings=[{"start_s": 60, "duration_s": 1200}],
+    )
+    answer = client.post("/v1/simulate", json=body)
+    assert answer.status_code == 200, answer.text[:300]
+    chain = answer.json()["cold_chain"]
+    assert chain["verdict"] == "breaks" and chain["product_max_c"] > 6.0
+
+
+@pytest.mark.parametrize(
+    ("spans", "changes", "field"),
+    [
+        (
+            [
+                {"start_s": 0, "duration_s": 200, "air_setpoint_c": 3.0},
+                {"start_s": 100, "duration_s": 100, "air_setpoint_c": 4.0},
+            ],
+            {},
+            "air_setpoints[1].start_s",
+        ),
+        (
+            [{"start_s": 1e7, "duration_s": 10, "air_setpoint_c": 3.0}],
+            {},
+            "air_setpoints[0].start_s",
+        ),
+        (
+            [{"start_s": 0, "duration_s": 10, "air_setpoint_c": 99.0}],
+            {},
+            "air_setpoints[0].air_setpoint_c",
+        ),
+        (
+            [{"start_s": 0, "duration_s": 10, "air_setpoint_c": "NaN"}],
+            {},
+            "air_setpoints[0].air_setpoint_c",
+        ),
+        (
+            [{"start_s": -1, "duration_s": 10, "air_setpoint_c": 3.0}],
+            {},
+            "air_setpoints[0].start_s",
+        ),
+        (
+            [{"start_s": 0, "duration_s": 10, "air_setpoint_c": 3.0}],
+            {"cargo_box": DYNAMIC},
+            "air_setpoints",
+        ),
+        (
+            [{"start_s": 0, "duration_s": 10, "air_setpoint_c": 3.0}],
+            {"refrigeration": {"strategy": "optimal"}},
+            "air_setpoints",
+        ),
+    ],
+)
+def test_a_bad_schedule_to_replay_is_a_422_naming_the_field(client, spans, changes, field):
+    body = _replay(spans, **changes)
+    assert named(client.post("/v1/simulate", json=body), body) == [field]
