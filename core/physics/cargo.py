@@ -155,6 +155,11 @@ def precondition_energy_j(box: CargoBoxParams, ambient_c: float) -> float:
     return -heat_j / box.heating_cop if box.heater_enabled else 0.0
 
 
+#: What a refrigeration unit followed through a trace: the thermostat at its set-point, a
+#: schedule (the optimal strategy's, or one replayed), or the best constant set-point.
+Followed = Literal["thermostat", "schedule", "best-constant"]
+
+
 @dataclass(frozen=True)
 class BoxResult:
     """Refrigeration of one trace, per step.
@@ -213,7 +218,7 @@ class BoxResult:
     precool_grid_j: float = 0.0
     product_before_c: FloatArray = field(default_factory=lambda: np.zeros(0))
     seconds_before_s: FloatArray = field(default_factory=lambda: np.zeros(0))
-    followed: Literal["thermostat", "schedule", "best-constant"] = "thermostat"
+    followed: Followed = "thermostat"
     best_constant: Callable[[], Any] | None = None
     unheld: tuple[int, str] | None = None
     notes: tuple[str, ...] = ()

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -40,6 +41,7 @@ from core.arrays import Blocks, FloatArray
 from core.params import CargoBoxParams, ProductBand, RefrigerationStrategy
 from core.physics.cargo import (
     BoxResult,
+    Followed,
     air_heat_capacity_j_k,
     door_conductances_w_k,
     refrigeration_cop,
@@ -288,7 +290,8 @@ def box_with_goods(
     constant set-point (:func:`best_constant`) keeps the goods at least as well for less by the
     strategy's objective: then on that."""
     day = DayInputs(outside, payload_kg, dt_s, start_c, run)
-    kept = follow(box, outside, payload_kg, dt_s, _constant(box.setpoint_c, payload_kg, start_c))
+    thermostat = _constant(box.setpoint_c, payload_kg, start_c)
+    kept = follow(box, outside, payload_kg, dt_s, thermostat)
     # the goods as loaded (none: the van leaves empty): a moment of no length
     aboard = bool(payload_kg.size and payload_kg[0] > 0)
     loaded = np.array([start_c[1] if aboard else np.nan])
@@ -299,54 +302,45 @@ def box_with_goods(
     )
     # a steady box is held by assumption: only the rating says the unit cannot
     held = unheld if box.mode == "steady" else None
-    if run.setpoint_c is not None:  # a schedule given: followed, the heater holding the floor
-        assert box.band is not None  # a box with a product
-        given = ~np.isnan(run.setpoint_c)
-        cool_to = np.where(given, run.setpoint_c, box.setpoint_c)
-        heat_to = np.where(given, np.minimum(cool_to, box.band.min_c), box.setpoint_c)
-        replayed = follow(box, outside, payload_kg, dt_s, Setpoints(cool_to, heat_to, start_c))
-        return replace(
-            replayed,
-            setpoint_c=cool_to,
-            product_before_c=loaded,
-            seconds_before_s=np.zeros(1),
-            followed="schedule",
-            thermostat=kept,
-            best_constant=functools.cache(functools.partial(best_constant, box, day)),
-            unheld=held,
-            notes=notes,
-        )
     narrow = _too_narrow(box) if run.strategy.strategy == "optimal" else ()
-    if run.strategy.strategy == "thermostat" or narrow:
-        return replace(
-            kept,
-            product_before_c=loaded,
-            seconds_before_s=np.zeros(1),
-            best_constant=functools.cache(functools.partial(best_constant, box, day)),
-            unheld=held,
-            notes=(*notes, *narrow),
-        )
-    unit = plan_unit(box, day)
-    if unit.followed == "best-constant":
-        chosen = replace(unit.box, setpoint_c=unit.setpoints.cool_to_c)
-    else:
-        chosen = replace(
-            unit.box,
-            setpoint_c=unit.setpoints.cool_to_c,
-            precool_grid_j=unit.setpoints.precool_grid_j,
-            product_before_c=np.concatenate((loaded, unit.setpoints.depot_product_c)),
-            seconds_before_s=np.concatenate(([0.0], unit.setpoints.depot_seconds_s)),
-        )
-    return replace(
-        chosen,
-        product_before_c=chosen.product_before_c if chosen.product_before_c.size else loaded,
-        seconds_before_s=chosen.seconds_before_s if chosen.seconds_before_s.size else np.zeros(1),
-        followed=unit.followed,
-        thermostat=kept,
-        best_constant=lambda: unit.constant,
-        unheld=held,
-        notes=notes,
+    constant: Callable[[], ConstantRun] = functools.cache(
+        functools.partial(best_constant, box, day)
     )
+    followed: Followed
+    if run.setpoint_c is not None:  # a schedule to replay: followed
+        setpoints = _replayed(box, run.setpoint_c, start_c)
+        result, followed = follow(box, outside, payload_kg, dt_s, setpoints), "schedule"
+    elif run.strategy.strategy == "thermostat" or narrow:
+        setpoints, result, followed = thermostat, kept, "thermostat"
+    else:
+        unit = plan_unit(box, day)
+        setpoints, result, followed = unit.setpoints, unit.box, unit.followed
+        constant = unit.baseline
+    planned = followed != "thermostat"
+    return replace(
+        result,
+        setpoint_c=setpoints.cool_to_c if planned else None,
+        thermostat=kept if planned else None,
+        precool_grid_j=setpoints.precool_grid_j,
+        product_before_c=np.concatenate((loaded, setpoints.depot_product_c)),
+        seconds_before_s=np.concatenate(([0.0], setpoints.depot_seconds_s)),
+        followed=followed,
+        best_constant=constant,
+        unheld=held,
+        notes=(*notes, *narrow),
+    )
+
+
+def _replayed(
+    box: CargoBoxParams, setpoint_c: FloatArray, start_c: tuple[float, float]
+) -> Setpoints:
+    """A schedule to replay (the air set-point of each step, NaN: the thermostat's) as what
+    the unit follows: it cools down to it, the heater holding the band's floor."""
+    assert box.band is not None  # a box with a product
+    given = ~np.isnan(setpoint_c)
+    cool_to = np.where(given, setpoint_c, box.setpoint_c)
+    heat_to = np.where(given, np.minimum(cool_to, box.band.min_c), box.setpoint_c)
+    return Setpoints(cool_to, heat_to, start_c)
 
 
 @dataclass(frozen=True)
@@ -359,6 +353,10 @@ class UnitPlan:
     box: BoxResult
     followed: Literal["schedule", "best-constant"]
     constant: ConstantRun
+
+    def baseline(self) -> ConstantRun:
+        """The best constant set-point's day, the plan weighed against."""
+        return self.constant
 
 
 def plan_unit(box: CargoBoxParams, day: DayInputs) -> UnitPlan:
