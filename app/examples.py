@@ -280,13 +280,14 @@ CALIBRATION_EXAMPLE: dict[str, Any] = _calibration_example()
 
 
 #: The morning round carrying chilled dairy (+6 °C at most, ATP Annex 3) loaded at 4 °C, and
-#: carrying frozen food (−18 °C, brief rises of 3 K), each box simulated with its unit's
-#: capacity and the goods' own temperature.
+#: carrying frozen food (−18 °C, brief rises of 3 K; a unit rated 7 kW at 0 °C, 3.3 kW at
+#: the frozen set-point), each box simulated with its unit's capacity and the goods' own
+#: temperature.
 CHILLED_PLAN_EXAMPLE: dict[str, Any] = PLAN_EXAMPLE | {
     "cargo_box": {"product": "chilled-dairy", "load_temperature_c": 4.0, "mode": "dynamic"}
 }
 FROZEN_PLAN_EXAMPLE: dict[str, Any] = PLAN_EXAMPLE | {
-    "cargo_box": {"product": "frozen", "mode": "dynamic", "refrigeration_capacity_w": 4000.0}
+    "cargo_box": {"product": "frozen", "mode": "dynamic", "refrigeration_capacity_w": 7000.0}
 }
 #: The chilled round with the unit's optimal strategy: pre-cooled at the depot, the air let
 #: float within the band, the battery spared.

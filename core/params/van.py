@@ -273,8 +273,47 @@ class CargoBoxParams(BoxGeometry, SwitchingUnit):
         0.0,
         ge=0,
         le=5000,
-        description="Draw of the unit's controls and evaporator fans whenever it runs [W]; 0 in "
-        "the paper.",
+        description="Draw of the unit's controls and evaporator fans while it runs (cools or "
+        "heats) [W], released in the box as heat the unit removes in turn; nothing while it is "
+        "off. 0 in the paper.",
+    )
+    capacity_box_slope_per_k: float = Field(
+        0.022,
+        ge=0,
+        le=0.05,
+        description="Share of its rated capacity the unit gains per kelvin of box air above the "
+        "rating's 0 °C [1/K] (dynamic mode): its compressor pumps denser vapour from a warmer "
+        "evaporator. 0.022 puts −20 °C at 56 % of the 0 °C rating, as small van units' ATP "
+        "ratings at 30 °C outside show (ATP Annex 1 Appendix 2 rates units at 30 °C "
+        "outside, 0 °C and −20 °C inside); 0: a constant capacity.",
+    )
+    capacity_ambient_slope_per_k: float = Field(
+        0.01,
+        ge=0,
+        le=0.05,
+        description="Share of its rated capacity the unit loses per kelvin of outside air above "
+        "the rating's 30 °C [1/K] (dynamic mode): a hotter condenser; about 1 %/K for "
+        "reciprocating and scroll compressors (Stoecker & Jones, Refrigeration and Air "
+        "Conditioning, ch. 12).",
+    )
+    min_modulation: float = Field(
+        0.3,
+        ge=0,
+        le=1,
+        description="Least share of its capacity a 'variable' unit runs at [–] (dynamic mode); "
+        "below it the compressor cycles on and off and loses cycling_degradation. 0: an "
+        "inverter that modulates to nothing.",
+    )
+    cycling_degradation: float = Field(
+        0.25,
+        ge=0,
+        le=0.5,
+        description="Degradation coefficient C_D of a compressor cycling on and off [–] "
+        "(dynamic mode): at a run-time fraction x it draws its full power over x but "
+        "delivers only PLF = 1 − C_D·(1 − x) of its capacity, the refrigerant redistributing "
+        "at each start; 0.25 is AHRI 210/240's default. An 'on-off' unit loses it as a "
+        "start-up ramp of time constant C_D·0.8·360 s (AHRI's cyclic test, 6 min on and 24 "
+        "off). 0: no cycling losses.",
     )
     structure_heat_capacity_j_k: float = Field(
         190_000.0,
@@ -338,7 +377,9 @@ class CargoBoxParams(BoxGeometry, SwitchingUnit):
         3000.0,
         ge=10,
         le=100_000,
-        description="Cooling capacity of the unit Q_0,max [W] (dynamic mode only); at least 10 W.",
+        description="Cooling capacity of the unit Q_0,max [W] (dynamic mode only) at ATP's "
+        "rating conditions, 0 °C in the box and 30 °C outside; it varies with both "
+        "(capacity_box_slope_per_k, capacity_ambient_slope_per_k). At least 10 W.",
     )
     product_limit_c: float = Field(
         7.0,

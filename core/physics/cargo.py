@@ -120,6 +120,74 @@ def refrigeration_cop(box: CargoBoxParams, ambient_c: ArrayLike, box_c: ArrayLik
     return np.minimum(box.carnot_fraction * evaporator_k / lift_k, MAX_CARNOT_COP)
 
 
+#: ATP's rating conditions of a unit's capacity: the box air [°C] and the outside air [°C].
+RATING_BOX_C = 0.0
+RATING_AMBIENT_C = 30.0
+#: Least share of its rating a unit delivers however cold the box or hot the day [–].
+MIN_CAPACITY_SHARE = 0.1
+
+
+def capacity_line_w(box: CargoBoxParams, ambient_c: ArrayLike) -> tuple[FloatArray, float]:
+    """The unit's cooling capacity as a line in the box air's temperature [W]: its value at
+    0 °C in each step's ``ambient_c`` and its slope [W/K] (``capacity_box_slope_per_k``,
+    ``capacity_ambient_slope_per_k``). The paper's steady box assumes the unit removes every
+    load; only the check of its rating (:func:`core.physics.cold_chain.box_with_goods`) uses
+    this there."""
+    ambient = np.asarray(ambient_c, dtype=float)
+    rated = box.refrigeration_capacity_w
+    at_zero = rated * (
+        1.0
+        - box.capacity_box_slope_per_k * RATING_BOX_C
+        - box.capacity_ambient_slope_per_k * (ambient - RATING_AMBIENT_C)
+    )
+    return at_zero, rated * box.capacity_box_slope_per_k
+
+
+def cooling_capacity_w(box: CargoBoxParams, ambient_c: ArrayLike, box_c: ArrayLike) -> FloatArray:
+    """The unit's cooling capacity Q_0,max [W] with the box air at ``box_c`` and the outside
+    air at ``ambient_c`` [°C]: its rating at 0 °C / 30 °C (ATP's conditions) along
+    :func:`capacity_line_w`, at least :data:`MIN_CAPACITY_SHARE` of it (the paper's steady
+    mode too: its rating)."""
+    at_zero, slope = capacity_line_w(box, ambient_c)
+    line = at_zero + slope * np.asarray(box_c, dtype=float)
+    return np.maximum(line, MIN_CAPACITY_SHARE * box.refrigeration_capacity_w)
+
+
+def part_load_factor(box: CargoBoxParams, load_share: ArrayLike) -> FloatArray:
+    """The share of its full-load COP a 'variable' unit reaches removing ``load_share`` of its
+    capacity [–]: 1 down to ``min_modulation``, below it cycling, ``PLF = 1 − C_D·(1 − x)``
+    with the run-time fraction ``x = load_share/min_modulation`` (AHRI 210/240; ASHRAE
+    Handbook — HVAC Systems and Equipment). An 'on-off' unit's losses are its start-up ramp
+    (:func:`core.physics.cold_chain.two_nodes`); the paper's steady unit has none."""
+    share = np.asarray(load_share, dtype=float)
+    if box.mode == "steady" or box.control == "on-off" or box.min_modulation <= 0:
+        return np.ones_like(share)
+    run_share = np.clip(share / box.min_modulation, 0.0, 1.0)
+    return 1.0 - box.cycling_degradation * (1.0 - run_share)
+
+
+def unit_power_w(
+    box: CargoBoxParams,
+    ambient_c: ArrayLike,
+    air_c: ArrayLike,
+    removed_w: FloatArray,
+    added_w: FloatArray | float,
+    paid_w: FloatArray | None = None,
+) -> FloatArray:
+    """Electric power of the unit [W] (eq. 12): the heat it removes over its COP at the
+    air's and the outside temperature and its part-load factor (:func:`part_load_factor`),
+    the heater's over its COP, and the standby draw (controls, evaporator fans) while it
+    runs. ``paid_w``: the heat an 'on-off' compressor is paid for (its capacity while on,
+    however much its start-up ramp delivers); None: ``removed_w``."""
+    cop = refrigeration_cop(box, ambient_c, air_c)
+    added = np.asarray(added_w, dtype=float)
+    if paid_w is None:
+        share = removed_w / cooling_capacity_w(box, ambient_c, air_c)
+        paid_w = removed_w / part_load_factor(box, share)
+    running = (removed_w > 0) | (added > 0)
+    return paid_w / cop + added / box.heating_cop + box.standby_power_w * running
+
+
 def door_conductance_w_k(box: CargoBoxParams, ambient_c: ArrayLike) -> FloatArray:
     """Heat let in through the fully open door per kelvin between outside and box [W/K].
 
@@ -268,22 +336,23 @@ def refrigeration(
     -----
     Steady mode (paper §4): the loads at the set-point, ``Q_0 = max(Q_z, 0)``,
     ``P = Q_0/COP`` (eq. 12), plus ``−Q_z/COP_heat`` when the box loses heat and the heater is
-    enabled, plus the standby draw. A box structure that starts warm is pulled down at the
-    unit's capacity from the start.
+    enabled, plus the standby draw while the unit runs (its fans' heat among the loads). A box
+    structure that starts warm is pulled down at the unit's capacity from the start.
 
     Dynamic mode: ``C·dϑ/dt = G·(ϑ_eq − ϑ) − Q_0`` with ``G = α·A + G_door`` and
     ``ϑ_eq = ϑ_amb + Q_sol/G``, solved exactly over steps of :data:`BOX_STEP_S` with constant
-    inputs. An ideal thermostat runs the unit at full cooling capacity while the box is above
-    its set-point, at full heating capacity (if enabled) while below, and matches the load at
-    the set-point. The state is the temperature, so unloading cargo changes only the heat
-    capacity, never the temperature.
+    inputs. An ideal thermostat runs the unit at full cooling capacity (at the box's and the
+    outside temperature, :func:`cooling_capacity_w`) while the box is above its set-point, at
+    full heating capacity (if enabled) while below, and matches the load at the set-point; its
+    fans' heat joins the load while it runs, and it is off while the box drifts below its
+    set-point without a heater. The state is the temperature, so unloading cargo changes only
+    the heat capacity, never the temperature.
     """
     door_conductance = door_conductances_w_k(box, ambient_c, door_open)
     if box.mode == "steady":
         temperature, cooling, heating = _steady(
             box, ambient_c, solar_heat, door_conductance, dt_s, initial_c
         )
-        cop = refrigeration_cop(box, ambient_c, box.setpoint_c)
     else:
         capacity = heat_capacity_j_k(box, np.broadcast_to(payload_kg, ambient_c.shape))
         start_c = box.setpoint_c
@@ -293,8 +362,7 @@ def refrigeration(
         temperature, cooling, heating = _integrate_box(
             box, ambient_c, solar_heat, door_conductance, capacity, dt_s, start_c
         )
-        cop = refrigeration_cop(box, ambient_c, temperature)
-    power = cooling / cop + heating / box.heating_cop + box.standby_power_w
+    power = unit_power_w(box, ambient_c, temperature, cooling, heating)
     above = temperature > box.product_limit_c
     return BoxResult(
         power_w=power,
@@ -315,9 +383,10 @@ def _steady(
     dt_s: float,
     initial_c: float | None,
 ) -> tuple[FloatArray, FloatArray, FloatArray | float]:
-    """The paper's steady box: at its set-point, the unit removing every load (and the heater
-    adding what it loses, if enabled), a structure that starts warm pulled down at the unit's
-    capacity from the start. Temperature [°C], heat removed and added in each step [W]."""
+    """The paper's steady box: at its set-point, the unit removing every load and its fans'
+    heat (and the heater adding what it loses, if enabled), a structure that starts warm
+    pulled down at the unit's capacity from the start. Temperature [°C], heat removed and
+    added in each step [W]."""
     setpoint = box.setpoint_c
     load = wall_heat_w(box, ambient_c, setpoint) + solar_heat
     load = load + door_conductance * (ambient_c - setpoint)
@@ -325,6 +394,9 @@ def _steady(
         pulldown_j = box.structure_heat_capacity_j_k * (initial_c - setpoint)
         rate_w = box.refrigeration_capacity_w if pulldown_j > 0 else box.heating_capacity_w
         load = load + _front_loaded(pulldown_j, rate_w, load.size, dt_s)
+    # the fans' heat while the unit runs: cooling, or heating what the box loses
+    running = (load >= 0) | box.heater_enabled
+    load = load + box.standby_power_w * running
     heating = np.maximum(-load, 0.0) if box.heater_enabled else 0.0
     return np.full_like(ambient_c, setpoint), np.maximum(load, 0.0), heating
 
@@ -358,21 +430,27 @@ def _integrate_box(
 
     wall_g = box.wall_heat_transfer_w_m2k * box.heat_transfer_area_m2
     conductance = wall_g + block_mean(door_conductance)
-    equilibrium = block_mean(ambient_c) + block_mean(solar_heat) / conductance
+    ambient = block_mean(ambient_c)
+    equilibrium = ambient + block_mean(solar_heat) / conductance
     capacity = block_mean(capacity_j_k)
     seconds = counts * dt_s
     setpoint = box.setpoint_c
-    cool_w = box.refrigeration_capacity_w
+    fan_w = box.standby_power_w
+    at_zero, slope = capacity_line_w(box, ambient)
+    least_w = MIN_CAPACITY_SHARE * box.refrigeration_capacity_w
     heat_w = box.heating_capacity_w if box.heater_enabled else 0.0
-    # At the set-point the unit must remove (or add) exactly the load.
+    # At the set-point the unit must remove (or add) exactly the load, its fans' heat with it;
+    # without a heater it is off while the box loses heat, and the box drifts.
     load_w = conductance * (equilibrium - setpoint)
-    holds = (load_w <= cool_w) & (load_w >= -heat_w)
+    net_w = load_w + fan_w
+    holds = (load_w >= 0) | (heat_w > 0)
+    holds &= (net_w <= np.maximum(at_zero + slope * setpoint, least_w)) & (net_w >= -heat_w)
     ends = np.full(edges.size, setpoint)
-    removed = np.maximum(load_w, 0.0)
-    added = np.maximum(-load_w, 0.0)
+    removed = np.maximum(net_w, 0.0)
+    added = np.maximum(-net_w, 0.0)
     breaks = np.flatnonzero(~holds)
-    g_list, eq_list, c_list, h_list = (
-        x.tolist() for x in (conductance, equilibrium, capacity, seconds)
+    g_list, eq_list, c_list, h_list, zero_list = (
+        x.tolist() for x in (conductance, equilibrium, capacity, seconds, at_zero)
     )
     t = start_c
     i = 0
@@ -388,13 +466,18 @@ def _integrate_box(
         decay = math.exp(-g * h / c)
         free = eq + (t - eq) * decay
         reach = (1.0 - decay) / g
+        running = eq + fan_w / g  # the equilibrium with the fans' heat
+        free_on = running + (t - running) * decay
         cool_j = heat_j = 0.0
         if free > setpoint:
-            end = max(free - cool_w * reach, setpoint)
-            cool_j = min(max(g * h * (eq - 0.5 * (t + end)) - c * (end - t), 0.0), cool_w * h)
+            cool_w = max(zero_list[i] + slope * t, least_w)
+            end = max(free_on - cool_w * reach, setpoint)
+            mean_gain = g * h * (running - 0.5 * (t + end))
+            cool_j = min(max(mean_gain - c * (end - t), 0.0), cool_w * h)
         elif free < setpoint and heat_w > 0:
-            end = min(free + heat_w * reach, setpoint)
-            heat_j = min(max(c * (end - t) - g * h * (eq - 0.5 * (t + end)), 0.0), heat_w * h)
+            end = min(free_on + heat_w * reach, setpoint)
+            mean_gain = g * h * (running - 0.5 * (t + end))
+            heat_j = min(max(c * (end - t) - mean_gain, 0.0), heat_w * h)
         else:
             end = free
         ends[i], removed[i], added[i] = end, cool_j / h, heat_j / h

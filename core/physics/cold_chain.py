@@ -40,11 +40,15 @@ from numba import njit
 from core.arrays import Blocks, FloatArray
 from core.params import CargoBoxParams, ProductBand, RefrigerationStrategy
 from core.physics.cargo import (
+    MIN_CAPACITY_SHARE,
     BoxResult,
     Followed,
     air_heat_capacity_j_k,
+    capacity_line_w,
+    cooling_capacity_w,
     door_conductances_w_k,
     refrigeration_cop,
+    unit_power_w,
     wall_heat_w,
 )
 from core.physics.strategy import GRID_S, GRID_WEIGHT, BoxDay, margin_k, optimal_schedule
@@ -68,12 +72,16 @@ class TwoNodes:
         The goods at the end of each step [°C]; NaN while none are aboard.
     removed_w, added_w
         Heat the unit removes, and the heater adds, in each step [W].
+    paid_w
+        Heat the compressor is paid for in each step [W]: an 'on-off' unit's capacity while it
+        runs, however much of it its start-up ramp delivers; else ``removed_w``.
     """
 
     air_c: FloatArray
     product_c: FloatArray
     removed_w: FloatArray
     added_w: FloatArray
+    paid_w: FloatArray
 
 
 def two_nodes(
@@ -81,6 +89,7 @@ def two_nodes(
     air_capacity_j_k: float,
     conductance_w_k: FloatArray,
     equilibrium_c: FloatArray,
+    ambient_c: FloatArray,
     payload_kg: FloatArray,
     setpoint_c: FloatArray | tuple[FloatArray, FloatArray],
     dt_s: float,
@@ -95,8 +104,8 @@ def two_nodes(
         and its goods (specific heat, conductance per kg).
     air_capacity_j_k
         ``C_a`` [J/K].
-    conductance_w_k, equilibrium_c
-        ``G`` [W/K] and ``ϑ_eq`` [°C] of each step.
+    conductance_w_k, equilibrium_c, ambient_c
+        ``G`` [W/K], ``ϑ_eq`` and the outside air (the unit's capacity) [°C] of each step.
     payload_kg
         The goods aboard in each step [kg].
     setpoint_c
@@ -110,10 +119,10 @@ def two_nodes(
     edges, counts, mean = blocks.edges, blocks.counts, blocks.mean
     mass = mean(payload_kg)
     cool_to, heat_to = setpoint_c if isinstance(setpoint_c, tuple) else (setpoint_c, setpoint_c)
-    air, product, removed, added = _on_blocks(
+    air, product, removed, added, paid = _on_blocks(
         box,
         (air_capacity_j_k, mass),
-        (mean(conductance_w_k), mean(equilibrium_c)),
+        (mean(conductance_w_k), mean(equilibrium_c), mean(ambient_c)),
         (mean(cool_to), mean(heat_to)),
         counts * dt_s,
         start_c,
@@ -128,37 +137,46 @@ def two_nodes(
         product_c=np.repeat(product, counts),
         removed_w=np.repeat(removed, counts),
         added_w=np.repeat(added, counts),
+        paid_w=np.repeat(paid, counts),
     )
 
 
 def _on_blocks(
     box: CargoBoxParams,
     capacity: tuple[float, FloatArray],
-    flows: tuple[FloatArray, FloatArray],
+    flows: tuple[FloatArray, FloatArray, FloatArray],
     setpoint_c: tuple[FloatArray, FloatArray],
     seconds: FloatArray,
     start_c: tuple[float, float],
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """:func:`_integrate` over blocks of ``seconds`` with the box's unit: ``capacity`` the
-    air's [J/K] and the goods aboard [kg], ``flows`` the conductance [W/K] and the
-    equilibrium [°C], ``setpoint_c`` what it cools down to and heats up to."""
+    air's [J/K] and the goods aboard [kg], ``flows`` the conductance [W/K], the equilibrium
+    and the outside air [°C], ``setpoint_c`` what it cools down to and heats up to."""
     steady = box.mode == "steady"
-    cool_w = math.inf if steady else box.refrigeration_capacity_w
+    conductance, equilibrium, ambient = flows
+    # the paper's steady unit removes every load
+    at_zero, slope = capacity_line_w(box, ambient)
+    if steady:
+        at_zero, slope = np.full(ambient.size, math.inf), 0.0
     heat_w = (math.inf if steady else box.heating_capacity_w) if box.heater_enabled else 0.0
     switching = (
         (box.differential_k, box.min_on_minutes * 60.0, box.min_off_minutes * 60.0)
         if box.control == "on-off"
         else (0.0, 0.0, 0.0)
     )
+    # an on-off unit's start-up ramp (its cycling losses, AHRI's cyclic test: 6 min on, 24 off)
+    ramp_s = box.cycling_degradation * 0.8 * 360.0 if box.control == "on-off" else 0.0
     air_j_k, mass = capacity
     return _integrate(
-        *flows,
+        conductance,
+        equilibrium,
         setpoint_c,
         (air_j_k, mass * box.cargo_specific_heat_j_kgk),
         mass * box.product_conductance_w_kgk,
         seconds,
-        (cool_w, heat_w),
-        switching,
+        (at_zero, slope, MIN_CAPACITY_SHARE * box.refrigeration_capacity_w),
+        (heat_w, box.standby_power_w),
+        (*switching, ramp_s),
         start_c,
     )
 
@@ -171,24 +189,31 @@ def _integrate(
     capacity: tuple[float, FloatArray],
     h: FloatArray,
     seconds: FloatArray,
+    cooling: tuple[FloatArray, float, float],
     unit: tuple[float, float],
-    switching: tuple[float, float, float],
+    switching: tuple[float, float, float, float],
     start: tuple[float, float],
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """Backward Euler over the blocks: the goods' equation solved for ``ϑ_p`` leaves the air's
     ``K·ϑ_a' = R − Q̇_0`` with ``K = C_a/Δt + G + k``, ``R = C_a/Δt·ϑ_a + G·ϑ_eq + k·ϑ_p`` and
     ``k = (C_p/Δt)·H/(C_p/Δt + H)``; the unit's ``Q̇_0 = R − K·ϑ_set`` within its limits
-    (``setpoint``: the air it cools down to, and the air it heats up to). An on-off unit
-    (``switching``: its differential [K] above 0, its shortest run and pause [s]) removes its
-    full capacity or nothing: on once the air is above the set-point by half the differential,
-    off once below it by half, each run and pause lasting their shortest at least."""
+    (``setpoint``: the air it cools down to, and the air it heats up to). ``cooling``: the
+    capacity at 0 °C in each block [W], its slope with the air [W/K] and its least [W], taken
+    at the block's start; ``unit``: the heater's capacity and the fans' draw [W], heat in the
+    air while the unit runs. An on-off unit (``switching``: its differential [K] above 0, its
+    shortest run and pause [s], its start-up ramp's time constant [s]) runs at its full
+    capacity or not at all — delivering ``1 − e^(−t/τ)`` of it ``t`` after each start, paid
+    in full: on once the air is above the set-point by half the differential, off once below
+    it by half, each run and pause lasting their shortest at least. Returns the air, the
+    goods [°C], the heat removed, added and paid for (:class:`TwoNodes`) [W]."""
     cool_to, heat_to = setpoint
     c_air, c_product = capacity
-    cool_w, heat_w = unit
-    differential, min_on, min_off = switching
+    at_zero, slope, least = cooling
+    heat_w, fan_w = unit
+    differential, min_on, min_off, ramp = switching
     n = g.size
     air, product = np.empty(n), np.empty(n)
-    removed, added = np.zeros(n), np.zeros(n)
+    removed, added, paid = np.zeros(n), np.zeros(n), np.zeros(n)
     ta, tp = start
     on, since = False, min_off  # a unit at rest long enough to start
     for i in range(n):
@@ -198,6 +223,7 @@ def _integrate(
         k = p * h[i] / both if both > 0 else 0.0
         big_k = a + g[i] + k
         r = a * ta + g[i] * eq[i] + k * tp
+        cool_w = max(at_zero[i] + slope * ta, least)
         if differential > 0:
             switch = (
                 ta > cool_to[i] + 0.5 * differential
@@ -206,22 +232,36 @@ def _integrate(
             )
             if switch and since >= (min_on if on else min_off):
                 on, since = not on, 0.0
+            share = 1.0
+            if on and ramp > 0:  # the mean of the ramp over the block
+                fade = math.exp(-since / ramp) - math.exp(-(since + seconds[i]) / ramp)
+                share -= ramp / seconds[i] * fade
             since += seconds[i]
-            q = cool_w if on else 0.0
-        else:
-            q = min(r - big_k * cool_to[i], cool_w)
-        if q <= 0:  # the air would end below the cooling set-point: heat only up to the other
-            # (an on-off unit's: below its own differential)
-            q = max(min(r - big_k * (heat_to[i] - 0.5 * differential), 0.0), -heat_w)
+            q = cool_w * share if on else 0.0
+            pay = cool_w if on else 0.0
+        else:  # it runs while the air would end above the set-point without it
+            need = r - big_k * cool_to[i]
+            q = min(need + fan_w, cool_w) if need > 0 else 0.0
+            pay = q
+        if q > 0:
+            r += fan_w
+        else:  # the air would end below the cooling set-point: heat only up to the other
+            # (an on-off unit's: below its own differential), the fans' heat helping
+            floor = heat_to[i] - 0.5 * differential
+            pay = q = 0.0
+            if heat_w > 0 and r + fan_w - big_k * floor < 0:
+                r += fan_w
+                q = max(r - big_k * floor, -heat_w)
         ta = (r - q) / big_k
         if both > 0:
             tp = (p * tp + h[i] * ta) / both
         air[i], product[i] = ta, tp
         if q > 0:
             removed[i] = q
+            paid[i] = pay
         else:
             added[i] = -q
-    return air, product, removed, added
+    return air, product, removed, added, paid
 
 
 @dataclass(frozen=True)
@@ -393,21 +433,23 @@ def _loading_notes(box: CargoBoxParams, loaded_c: float | None) -> tuple[str, ..
 
 
 def _unheld(box: CargoBoxParams, outside: Outside) -> tuple[int, str] | None:
-    """The first step in which the walls and the sun alone bring more heat than the unit
-    removes with the air at the band's ceiling, and a warning saying so; None: none."""
+    """The first step in which the walls, the sun and the unit's fans alone bring more heat
+    than the unit removes with the air at the band's ceiling (its capacity there,
+    :func:`core.physics.cargo.cooling_capacity_w`), and a warning saying so; None: none."""
     band = box.band
     assert band is not None  # a box with a product
-    load_w = wall_heat_w(box, outside[0], band.max_c) + outside[1]
-    over = np.flatnonzero(load_w > box.refrigeration_capacity_w)
+    load_w = wall_heat_w(box, outside[0], band.max_c) + outside[1] + box.standby_power_w
+    capacity_w = np.broadcast_to(cooling_capacity_w(box, outside[0], band.max_c), np.shape(load_w))
+    over = np.flatnonzero(load_w > capacity_w)
     if not over.size:
         return None
     at = int(over[0])
-    worst = int(np.argmax(load_w))
+    worst = int(np.argmax(load_w - capacity_w))
     return (
         at,
-        f"the unit's {box.refrigeration_capacity_w / 1000:.1f} kW cannot hold the goods' band: "
-        f"with {float(outside[0][worst]):.0f} °C outside, the walls and the sun alone bring "
-        f"{float(load_w[worst]) / 1000:.1f} kW into the box at {band.max_c:g} °C",
+        f"the unit's {float(capacity_w[worst]) / 1000:.1f} kW (at {band.max_c:g} °C in the box "
+        f"and {float(outside[0][worst]):.0f} °C outside) cannot hold the goods' band: the "
+        f"walls, the sun and its fans alone bring {float(load_w[worst]) / 1000:.1f} kW",
     )
 
 
@@ -515,8 +557,8 @@ def best_constant(box: CargoBoxParams, day: DayInputs) -> ConstantRun:
     seconds = blocks.counts * day.dt_s
     mass = mean(day.payload_kg)
     _, conductance, equilibrium = _flows(box, day.outside)
-    flows = (mean(conductance), mean(equilibrium))
     ambient = mean(day.outside[0])
+    flows = (mean(conductance), mean(equilibrium), ambient)
     weight = mean(day.run.weights()[0]) * seconds
     air_j_k = air_heat_capacity_j_k(box)
     aboard = mass > 0
@@ -533,12 +575,12 @@ def best_constant(box: CargoBoxParams, day: DayInputs) -> ConstantRun:
 
     def score(setpoint_c: float) -> tuple[float, float]:
         setpoint = np.full(seconds.size, setpoint_c)
-        air, product, removed, added = _on_blocks(
+        air, product, removed, added, paid = _on_blocks(
             box, (air_j_k, mass), flows, (setpoint, setpoint), seconds, start(setpoint_c)
         )
         outside_k = np.maximum(product - ceiling, 0.0) + np.maximum(floor - product, 0.0)
         minutes = float((outside_k * seconds)[aboard].sum() / 60.0)
-        power = removed / refrigeration_cop(box, ambient, air) + added / box.heating_cop
+        power = _power_w(box, ambient, air, removed, added, paid)
         return round(minutes / KELVIN_MINUTE_TOLERANCE), float((power * weight).sum())
 
     best = high
@@ -577,6 +619,7 @@ def follow(
         air_heat_capacity_j_k(box),
         conductance,
         equilibrium,
+        outside[0],
         payload_kg,
         (setpoints.cool_to_c, setpoints.heat_to_c),
         dt_s,
@@ -593,11 +636,9 @@ def _result(
     nodes: TwoNodes,
     dt_s: float,
 ) -> BoxResult:
-    """The unit's power (eq. 12: the heat removed over the COP at the air's temperature, the
-    heater's, the standby draw) and the heat flows at the air's temperature."""
+    """The unit's power (:func:`_power_w`) and the heat flows at the air's temperature."""
     air = nodes.air_c
-    cop = refrigeration_cop(box, ambient_c, air)
-    power = nodes.removed_w / cop + nodes.added_w / box.heating_cop + box.standby_power_w
+    power = _power_w(box, ambient_c, air, nodes.removed_w, nodes.added_w, nodes.paid_w)
     return BoxResult(
         power_w=power,
         wall_heat_w=wall_heat_w(box, ambient_c, air),
@@ -608,6 +649,21 @@ def _result(
         minutes_above_limit=float((air > box.product_limit_c).sum() * dt_s / 60.0),
         product_c=nodes.product_c,
     )
+
+
+def _power_w(
+    box: CargoBoxParams,
+    ambient_c: FloatArray,
+    air_c: FloatArray,
+    removed_w: FloatArray,
+    added_w: FloatArray,
+    paid_w: FloatArray,
+) -> FloatArray:
+    """The unit's power [W] (:func:`core.physics.cargo.unit_power_w`, eq. 12): an on-off
+    unit's compressor paid for its capacity while it runs, a variable one's at its part
+    load."""
+    paid = paid_w if box.control == "on-off" else None
+    return unit_power_w(box, ambient_c, air_c, removed_w, added_w, paid)
 
 
 def grid_step_s(span_s: float) -> float:
@@ -651,6 +707,7 @@ def plan_setpoints(
                 refrigeration_cop(box, grid_outside, box.setpoint_c), grid_outside.shape
             ),
             weight=mean(weights),
+            ambient_c=grid_outside,
             door_open=mean(door_w_k),
         )
     ]
@@ -683,12 +740,14 @@ def plan_setpoints(
     heat_to = np.repeat(np.where(schedule.added_w[m:] > 0, air, box.band.min_c), counts)
     depot = slice(0, m)
     # the grid's energy at the depot: every joule of the unit there, the compressor's at the
-    # COP of the air it actually reached (the programme priced it at the set-point's)
-    precool_w = (
-        schedule.removed_w[depot]
-        / refrigeration_cop(box, day.equilibrium_c[depot], schedule.air_c[depot])
-        + schedule.added_w[depot] / box.heating_cop
-        + box.standby_power_w
+    # COP of the air it actually reached and its part load (the programme priced it at the
+    # set-point's, at full load)
+    precool_w = unit_power_w(
+        box,
+        day.equilibrium_c[depot],
+        schedule.air_c[depot],
+        schedule.removed_w[depot],
+        schedule.added_w[depot],
     )
     return Setpoints(
         cool_to,
@@ -720,6 +779,7 @@ def _constant_day(
         payload_kg=np.full(m, payload_kg),
         cop=np.full(m, float(refrigeration_cop(box, ambient_c, box.setpoint_c))),
         weight=np.full(m, weight),
+        ambient_c=np.full(m, ambient_c),
         door_open=np.zeros(m),
     )
 

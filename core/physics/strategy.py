@@ -5,16 +5,20 @@ management system") on its own box model with the goods as a node of their own
 (:mod:`core.physics.cold_chain`).
 
 A linear programme on a grid of :data:`GRID_S` (scipy's HiGHS). Per step ``k``: the heat the
-unit removes ``q_k ∈ [0, Q_0,max]`` and the heater adds ``h_k ∈ [0, Q_h,max]`` (0 without
-heater), the air's and the goods' temperatures at the step's end, and the slack ``s_k ≥ 0``
-by which the goods leave their band (priced at :data:`SLACK_PENALTY`: a day the unit cannot
-hold is answered, the slack saying where). The box's equations are
-:func:`core.physics.cold_chain.two_nodes`' backward-Euler steps, exactly::
+unit removes ``q_k ∈ [0, Q_0,max(ϑa_k)]`` (its capacity at the air's temperature and the
+outside's, linear in the air: :func:`core.physics.cargo.capacity_line_w`) and the heater
+adds ``h_k ∈ [0, Q_h,max]`` (0 without heater), the air's and the goods' temperatures at
+the step's end, and the slack ``s_k ≥ 0`` by which the goods leave their band (priced at
+:data:`SLACK_PENALTY`: a day the unit cannot hold is answered, the slack saying where).
+The box's equations are :func:`core.physics.cold_chain.two_nodes`' backward-Euler steps,
+exactly::
 
     (a + G_k + H_k)·ϑa_k − H_k·ϑp_k + q_k − h_k = a·ϑa_{k−1} + G_k·ϑeq_k
     (p_k + H_k)·ϑp_k − H_k·ϑa_k                 = p_k·ϑp_{k−1}
 
-with ``a = C_a/Δt``, ``p_k = C_p,k/Δt``. The goods stay within their band less a margin while
+with ``a = C_a/Δt``, ``p_k = C_p,k/Δt`` (the fans' heat on the right of the air's, as if
+the unit ran throughout; its part-load losses are left to the simulation, which follows the
+schedule and counts them). The goods stay within their band less a margin while
 aboard; the air within the band (an EN 12830 recorder logs it) but while a door is open. The
 objective is
 ``Σ (q_k/COP_k + h_k/COP_h)·Δt·w_k`` with ``w_k`` 1 on the battery and, while plugged in,
@@ -45,6 +49,7 @@ from scipy.sparse import coo_matrix
 from core.arrays import FloatArray
 from core.params import CargoBoxParams, ProductBand
 from core.physics.battery import JOULES_PER_KWH
+from core.physics.cargo import capacity_line_w
 
 #: The programme's step [s].
 GRID_S = 60.0
@@ -76,8 +81,9 @@ AIR_PENALTY = 1.0
 class BoxDay:
     """The day on the programme's grid, per step: its length [s], the box's conductance
     ``G`` [W/K] and equilibrium ``ϑ_eq`` [°C] (walls, door and sun), the goods aboard [kg], the
-    unit's cooling COP [–], what a joule drawn then weighs in the objective, and the open
-    door's conductance [W/K] (the air may leave its band where it is above 0; None: never)."""
+    unit's cooling COP [–], what a joule drawn then weighs in the objective, the outside air
+    [°C] (the unit's capacity) and the open door's conductance [W/K] (the air may leave its
+    band where it is above 0; None: never)."""
 
     seconds: FloatArray
     conductance_w_k: FloatArray
@@ -85,6 +91,7 @@ class BoxDay:
     payload_kg: FloatArray
     cop: FloatArray
     weight: FloatArray
+    ambient_c: FloatArray
     door_open: FloatArray | None = None
 
 
@@ -132,17 +139,17 @@ def optimal_schedule(
     cost[:, _S] = SLACK_PENALTY * day.seconds / 60.0
     cost[:, _U] = AIR_PENALTY * day.seconds / 60.0
     steady = box.mode == "steady"
-    cool = np.inf if steady else box.refrigeration_capacity_w
     heat = (np.inf if steady else box.heating_capacity_w) if box.heater_enabled else 0.0
     solved = milp(
         cost.ravel(),
         bounds=Bounds(
             np.tile([0.0, 0.0, -np.inf, -np.inf, 0.0, 0.0], n),
-            np.tile([cool, heat] + [np.inf] * 4, n),
+            np.tile([np.inf, heat] + [np.inf] * 4, n),
         ),
         constraints=[
             LinearConstraint(a_eq, rhs, rhs),
             _band_rows(band, day, swing, (held_steps, start_c)),
+            _capacity_rows(box, day),
         ],
     )
     if solved.x is None:
@@ -155,6 +162,22 @@ def optimal_schedule(
         added_w=np.maximum(x[:, _H], 0.0),
         outside_k=x[:, _S],
     )
+
+
+def _capacity_rows(box: CargoBoxParams, day: BoxDay) -> LinearConstraint:
+    """The unit's cooling capacity at the air's temperature in each step,
+    ``q_k − slope·ϑa_k ≤ Q_0(0 °C)`` (:func:`core.physics.cargo.capacity_line_w`; its floor
+    left out, as the programme keeps the air in the band); none in the steady mode."""
+    n = day.seconds.size
+    at_zero, slope = capacity_line_w(box, day.ambient_c)
+    if box.mode == "steady":
+        at_zero, slope = np.full(n, np.inf), 0.0
+    k = np.arange(n)
+    rows = np.concatenate([k, k])
+    cols = np.concatenate([_VARS * k + _Q, _VARS * k + _TA])
+    vals = np.concatenate([np.ones(n), np.full(n, -slope)])
+    matrix = coo_matrix((vals, (rows, cols)), shape=(n, _VARS * n)).tocsr()
+    return LinearConstraint(matrix, -np.inf, at_zero)
 
 
 def _equalities(
@@ -183,7 +206,8 @@ def _equalities(
         [a + g + h, -h, ones, -ones, np.where(empty, 1.0, both), -h, -a[rest], -keep[rest]]
     )
     rhs = np.zeros(2 * n)
-    rhs[air] = g * day.equilibrium_c
+    # the fans' heat as if the unit ran throughout: the simulation counts it only while it does
+    rhs[air] = g * day.equilibrium_c + box.standby_power_w
     if n:
         rhs[0] += a[0] * start_c[0]
         rhs[1] = keep[0] * start_c[1]

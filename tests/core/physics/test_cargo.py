@@ -10,11 +10,13 @@ from core.params import CargoBoxParams
 from core.physics.cargo import (
     MAX_CARNOT_COP,
     air_density_kg_m3,
+    cooling_capacity_w,
     door_heat_w,
     heat_capacity_j_k,
     precondition_energy_j,
     refrigeration,
     refrigeration_cop,
+    unit_power_w,
     wall_heat_w,
 )
 
@@ -89,13 +91,15 @@ def _exact_c(ambient_c, start_c, conductance_w_k, capacity_j_k, unit_w, seconds)
 
 
 UA = 2.172 * AREA  # 66.47 W/K (eq. 11)
+#: A unit of constant capacity: the hand calculations of the integration below.
+CONSTANT_UNIT = {"capacity_box_slope_per_k": 0.0, "capacity_ambient_slope_per_k": 0.0}
 
 
 def test_dynamic_mode_warms_when_capacity_is_short():
     # 34 °C outside, 1000 W of cooling against a 1994 W wall load: the box warms along the
     # exact first-order response with the loads at its current temperature. Heat capacity:
     # 550 kg · 2300 + 8 m³ of air + 190 kJ/K of box structure.
-    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000)
+    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000, **CONSTANT_UNIT)
     result = _run(box, 34.0)
     capacity = heat_capacity_j_k(box, 550.0)
     assert capacity == pytest.approx(550 * 2300 + 8 * air_density_kg_m3(4.0) * 1006 + 190_000)
@@ -109,7 +113,7 @@ def test_dynamic_mode_warms_when_capacity_is_short():
 def test_dynamic_mode_counts_minutes_above_product_limit():
     # empty box (air + structure ≈ 200 kJ/K): 7 °C is crossed at
     # t = −τ·ln((7 − ϑ_eq)/(4 − ϑ_eq)), τ = C/UA, ϑ_eq = 34 − 1000/UA
-    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000)
+    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000, **CONSTANT_UNIT)
     result = _run(box, 34.0, payload=0.0, n=1200)
     capacity = heat_capacity_j_k(box, 0.0)
     equilibrium = 34 - 1000 / UA
@@ -121,7 +125,7 @@ def test_dynamic_mode_counts_minutes_above_product_limit():
 
 
 def test_dynamic_box_recovers_after_the_load_drops():
-    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000)
+    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=1000, **CONSTANT_UNIT)
     ambient = np.concatenate((np.full(300, 34.0), np.full(3000, 4.0)))
     n = ambient.size
     result = refrigeration(box, ambient, np.zeros(n), np.zeros(n), np.full(n, 550.0), 1.0)
@@ -137,7 +141,7 @@ def test_empty_box_with_an_open_door_stays_below_the_outside_air():
     from core.params import DoorOpening, Location, VanParams, Weather
     from core.physics.simulate import simulate
 
-    box = CargoBoxParams(mode="dynamic")
+    box = CargoBoxParams(mode="dynamic", **CONSTANT_UNIT)
     van = VanParams(cargo_box=box)
     start = dt.datetime(2026, 7, 15, 3, tzinfo=ZoneInfo("Europe/Vienna"))
     result = simulate(
@@ -213,8 +217,8 @@ def test_carnot_cop_by_hand():
 def test_cold_day_heats_over_heating_cop_with_standby():
     box = CargoBoxParams(heater_enabled=True, heating_cop=2.0, standby_power_w=150)
     result = _run(box, -6.0)
-    # wall loss 664.72 W / COP_heat 2 + 150 W standby
-    assert result.power_w == pytest.approx(np.full(600, 664.72 / 2 + 150), abs=0.05)
+    # wall loss 664.72 W less the fans' 150 W of heat, over COP_heat 2, + the fans' 150 W
+    assert result.power_w == pytest.approx(np.full(600, (664.72 - 150) / 2 + 150), abs=0.05)
 
 
 def test_dynamic_heater_short_of_the_loss_lets_the_box_cool():
@@ -236,3 +240,56 @@ def test_warm_box_structure_is_pulled_down_at_the_units_capacity():
     assert extra_j == pytest.approx(190_000 * 26, rel=1e-9)
     assert (warm.power_w - cold.power_w)[0] == pytest.approx(3000 / 1.5)
     assert precondition_energy_j(box, 30.0) == pytest.approx(190_000 * 26 / 1.5)
+
+
+def test_capacity_falls_with_a_colder_box_and_a_hotter_day():
+    # rated at ATP's 0 °C inside / 30 °C outside; 2.2 %/K of box air, 1 %/K of outside air:
+    # −20 °C inside → 1 − 0.44 = 56 % (small van units' ratings), 40 °C outside → 90 %
+    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=2500)
+    assert cooling_capacity_w(box, 30.0, 0.0) == pytest.approx(2500.0)
+    assert cooling_capacity_w(box, 30.0, -20.0) == pytest.approx(0.56 * 2500)
+    assert cooling_capacity_w(box, 40.0, 0.0) == pytest.approx(0.90 * 2500)
+    assert cooling_capacity_w(box, 35.0, 4.0) == pytest.approx((1 + 0.088 - 0.05) * 2500)
+    # never below a tenth of the rating; the paper's steady box is rated alike (its check)
+    assert cooling_capacity_w(box, 80.0, -40.0) == pytest.approx(250.0)
+    assert cooling_capacity_w(BOX, 30.0, -20.0) == pytest.approx(0.56 * 3000)  # its rating
+
+
+def test_a_frozen_box_warms_where_the_rating_at_0_c_would_hold_it():
+    # an empty box at −20 °C, 30 °C outside: walls UA·50 = 3323 W against a 4000 W rating at
+    # 0 °C, but 0.56 · 4000 = 2240 W at −20 °C: the box warms towards where the capacity
+    # meets the walls, UA·(30 − ϑ) = 4000·(1 + 0.022·ϑ) → ϑ = (30·UA − 4000)/(UA + 88)
+    box = CargoBoxParams(
+        mode="dynamic", refrigeration_capacity_w=4000, setpoint_c=-20.0, product_limit_c=-15.0
+    )
+    result = _run(box, 30.0, payload=0.0, n=4 * 3600)
+    meets_c = (30 * UA - 4000) / (UA + 88)  # −13.0 °C
+    assert result.temperature_c[-1] == pytest.approx(meets_c, abs=0.05)
+    constant = box.model_copy(update={"capacity_box_slope_per_k": 0.0})
+    assert _run(constant, 30.0, payload=0.0).max_temperature_c == -20.0
+
+
+def test_the_fans_heat_the_box_while_the_unit_runs_and_stop_with_it():
+    # 150 W of fans: the unit removes the walls' 1994.16 W and the fans' 150 W (eq. 12 at
+    # COP 1.5) and draws the fans'; on a cold day without heater it is off: nothing at all
+    box = CargoBoxParams(standby_power_w=150.0)
+    assert _run(box, 34.0).power_w == pytest.approx(
+        np.full(600, (1994.16 + 150) / 1.5 + 150), abs=0.05
+    )
+    assert np.all(_run(box, -6.0).power_w == 0)
+    dynamic = CargoBoxParams(mode="dynamic", standby_power_w=150.0, min_modulation=0.0)
+    held = _run(dynamic, 34.0)
+    assert held.power_w == pytest.approx(np.full(600, (1994.16 + 150) / 1.5 + 150), abs=0.05)
+    cold = _run(dynamic, -6.0, payload=0.0, n=3600)
+    assert np.all(cold.power_w == 0) and cold.temperature_c[-1] < 0
+
+
+def test_a_variable_unit_below_its_least_speed_cycles_and_loses_its_degradation():
+    # 300 W of load on a 3000 W unit that modulates down to 30 %: run-time fraction
+    # x = 0.1/0.3, PLF = 1 − 0.25·(1 − 1/3) = 0.8333 (AHRI 210/240); above 900 W no loss
+    box = CargoBoxParams(mode="dynamic", refrigeration_capacity_w=3000, **CONSTANT_UNIT)
+    low = unit_power_w(box, 30.0, 0.0, np.array([300.0]), 0.0)
+    assert low == pytest.approx([300 / 1.5 / (1 - 0.25 * (1 - 1 / 3))])
+    assert unit_power_w(box, 30.0, 0.0, np.array([1200.0]), 0.0) == pytest.approx([800.0])
+    steady = CargoBoxParams()  # the paper's unit: none
+    assert unit_power_w(steady, 30.0, 0.0, np.array([300.0]), 0.0) == pytest.approx([200.0])

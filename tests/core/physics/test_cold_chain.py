@@ -158,18 +158,24 @@ def test_goods_loaded_outside_their_band_break_it_from_loading():
 
 
 def test_a_steady_box_whose_unit_is_too_weak_for_the_band_breaks_and_says_why():
-    # the paper's box (K = 2.172 W/(m²·K), 30.6 m², a 3 kW unit) with frozen goods at 35 °C:
-    # the walls alone bring 2.172 × 30.604 × (35 + 18) ≈ 3,523 W at the band's ceiling — the
-    # steady box assumes the unit removes it, so the verdict breaks, from the first step,
-    # with the unit's shortfall
+    # the paper's box (K = 2.172 W/(m²·K), 30.6 m², a unit rated 3 kW at 0 °C / 30 °C) with
+    # frozen goods at 35 °C: the walls alone bring 2.172 × 30.604 × (35 + 18) ≈ 3,523 W at the
+    # band's ceiling, where the unit has 3000 × (1 − 0.022·18 − 0.01·5) = 1,662 W — the steady
+    # box assumes the unit removes it, so the verdict breaks, from the first step, with the
+    # unit's shortfall
     frozen = CargoBoxParams(product="frozen", load_temperature_c=-24.0)
     assert frozen.mode == "steady" and frozen.refrigeration_capacity_w == 3000.0
     weak = run(frozen, 1.0, ambient_c=35.0)
     assert weak.unheld is not None and weak.unheld[0] == 0
-    assert "3.0 kW cannot hold the goods' band" in weak.unheld[1] and "3.5 kW" in weak.unheld[1]
+    assert "1.7 kW (at -18 °C in the box and 35 °C outside) cannot hold" in weak.unheld[1]
+    assert "3.5 kW" in weak.unheld[1]
     assert weak.unheld[1] in weak.notes
     check = box_check(PRODUCT_CLASSES["frozen"], weak, 1.0)
     assert not check.holds and check.reason == weak.unheld[1]
-    # 4 kW holds it
-    strong = run(frozen.model_copy(update={"refrigeration_capacity_w": 4000.0}), 1.0, 35.0)
+    # rated 4 kW at 0 °C, 2.2 kW at −18 °C: still short; 6.5 kW (3.6 kW there) holds it
+    rated = 4000.0, 6500.0
+    short, strong = (
+        run(frozen.model_copy(update={"refrigeration_capacity_w": w}), 1.0, 35.0) for w in rated
+    )
+    assert short.unheld is not None and "2.2 kW" in short.unheld[1]
     assert strong.unheld is None and box_check(PRODUCT_CLASSES["frozen"], strong, 1.0).holds
