@@ -400,14 +400,24 @@ class UnitPlan:
 
 
 def plan_unit(box: CargoBoxParams, day: DayInputs) -> UnitPlan:
-    """The optimal strategy on ``day``: the programme's schedule
-    (:func:`plan_setpoints`), or the best constant set-point (:func:`best_constant`) where the
+    """The optimal strategy on ``day``: the programme's schedule (:func:`plan_setpoints`) —
+    with the pre-cooling at the depot, or without it where the full physics finds that
+    cheaper (the programme prices the fans while the unit runs and its cycling below its
+    least speed linearly, and an hour at the depot can leave the unit idling through the day
+    where those losses are) — or the best constant set-point (:func:`best_constant`) where the
     schedule would leave the goods out longer, cost more by the objective or, by the energy
     objective, draw more from the battery. A re-plan under way runs this from the box's
     state."""
     args = (day.outside, day.payload_kg, day.dt_s)
     planned = plan_setpoints(box, *args, day.start_c, day.run)
     scheduled = follow(box, *args, planned)
+    strategy = day.run.strategy
+    if day.run.from_depot and strategy.precool_minutes > 0:
+        at_once = replace(day.run, strategy=strategy.model_copy(update={"precool_minutes": 0.0}))
+        unplanned = plan_setpoints(box, *args, day.start_c, at_once)
+        leaving = follow(box, *args, unplanned)
+        if _costlier(box, day, (scheduled, planned.precool_grid_j), (leaving, 0.0)):
+            planned, scheduled = unplanned, leaving
     constant = best_constant(box, day)
     if _costlier(box, day, (scheduled, planned.precool_grid_j), (constant.box, 0.0)):
         setpoints = _constant(constant.setpoint_c, day.payload_kg, constant.start_c)

@@ -197,11 +197,12 @@ def test_the_optimal_strategy_spares_the_battery_and_says_its_schedule(client):
     assert kept["strategy"] == "thermostat" and planned["strategy"] == "optimal"
     assert kept["battery_kwh"] == pytest.approx(kept["thermostat_battery_kwh"])
     assert kept["grid_kwh"] == 0.0 and {s["air_setpoint_c"] for s in kept["schedule"]} == {3.0}
-    # the same day's thermostat beside the optimum, which draws less from the battery and
-    # pre-cools on the grid
+    # the same day's thermostat beside the optimum, which draws less from the battery; the
+    # paper's poorly insulated box would spend 1.46 kWh of the grid on an hour of pre-cooling
+    # to spare 0.14 of the battery: more by the objective (a grid kWh a tenth), left out
     assert planned["thermostat_battery_kwh"] == pytest.approx(kept["battery_kwh"], rel=1e-9)
     assert planned["battery_kwh"] < 0.9 * kept["battery_kwh"]
-    assert planned["grid_kwh"] > 0.0
+    assert planned["grid_kwh"] == 0.0
     for answer in answers.values():
         assert check_agrees(answer)["verdict"] == "holds"
         rf = answer["refrigeration"]
@@ -228,7 +229,7 @@ def test_the_optimal_strategy_spares_the_battery_and_says_its_schedule(client):
     ]
     assert shut and min(shut) >= 0.0 and max(shut) <= 6.0 + 0.5
     setpoints = [s["air_setpoint_c"] for s in planned["schedule"]]
-    assert min(setpoints) < 3.0 < max(setpoints)  # colder at the depot, warmer on the road
+    assert min(setpoints) > 3.0 and max(setpoints) > 5.5  # warmer on the road, to the band's top
     # measured against the thermostat it replaces and the best constant set-point, which it
     # beats on the battery (or follows)
     thermostat, best = planned["baselines"]
@@ -295,10 +296,10 @@ def test_the_cost_objective_prices_the_battery_at_the_depot_and_costs_least(clie
         assert check_agrees(answer)["verdict"] == "holds"
     cheapest, sparing = answers["cost"]["refrigeration"], answers["energy"]["refrigeration"]
     # the grid's kWh at the depot costs the battery's less the charging losses, not a tenth:
-    # pre-cooling pays less, and the day costs less than the energy objective's and the
-    # thermostat's
-    assert cheapest["grid_kwh"] < sparing["grid_kwh"]
-    assert cheapest["cost"] < min(sparing["cost"], sparing["thermostat_cost"])
+    # pre-cooling pays no more (on this poorly insulated box, neither objective pre-cools),
+    # and the day costs no more than the energy objective's and less than the thermostat's
+    assert cheapest["grid_kwh"] <= sparing["grid_kwh"]
+    assert cheapest["cost"] <= sparing["cost"] < sparing["thermostat_cost"]
     # without a price it is not asked for: null
     plain = plan(client, cargo)["refrigeration"]
     assert plain["cost"] is None and plain["objective"] == "energy"
@@ -572,3 +573,20 @@ def test_a_schedule_replayed_on_a_worse_day_says_what_the_goods_went_through(cli
 def test_a_bad_schedule_to_replay_is_a_422_naming_the_field(client, spans, changes, field):
     body = _replay(spans, **changes)
     assert named(client.post("/v1/simulate", json=body), body) == [field]
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("capacity_box_slope_per_k", 0.2),  # −20 °C would leave no capacity at all
+        ("capacity_ambient_slope_per_k", -0.01),
+        ("min_modulation", 1.5),
+        ("cycling_degradation", 0.9),  # AHRI's default 0.25; past 0.5 a unit delivers nothing
+        ("capacity_box_slope_per_k", "NaN"),
+    ],
+)
+def test_a_unit_curve_out_of_its_range_is_a_422_naming_it(client, field, value):
+    body = PLAN_EXAMPLE | {"cargo_box": DYNAMIC | {"product": "chilled-dairy", field: value}}
+    refused = client.post("/v1/plans", json=body)
+    assert refused.status_code == 422, refused.text[:300]
+    assert [e["field"] for e in refused.json()["errors"]] == [f"cargo_box.{field}"]
