@@ -109,6 +109,14 @@ def summer_day(box, strategy):
     return day(box, strategy, payload=summer_payload(n), doors=STOPS.tolist(), sun=250.0)
 
 
+def summer_inputs(box):
+    """The summer day's box inputs at 1 s (outside, goods aboard) and its start (the air at
+    the set-point, the goods as loaded)."""
+    n = 8 * HOUR
+    outside = (np.full(n, 30.0), np.full(n, 250.0), summer_doors(n))
+    return outside, summer_payload(n), (box.setpoint_c, box.load_c)
+
+
 def test_the_goods_mass_and_pre_cooling_spare_the_battery_inside_the_band():
     # a unit without fans and cycling losses, as the programme prices it
     box = reference_box(standby_power_w=0.0, min_modulation=0.0)
@@ -346,13 +354,11 @@ def test_pre_cooling_is_left_out_where_the_full_physics_finds_it_does_not_pay():
     # tenth of a battery kWh) — the unit idles through the day where those losses are — so
     # the strategy leaves the depot at once, as without pre-cooling
     box = reference_box()
-    n = 8 * HOUR
-    payload = summer_payload(n)
-    outside = (np.full(n, 30.0), np.full(n, 250.0), summer_doors(n))
-    start = (box.setpoint_c, box.load_c)
+    outside, payload, start = summer_inputs(box)
     weighed = {}
     for minutes in (0.0, 60.0):
-        run = Run(RefrigerationStrategy(strategy="optimal", precool_minutes=minutes), np.zeros(n))
+        strategy = RefrigerationStrategy(strategy="optimal", precool_minutes=minutes)
+        run = Run(strategy, np.zeros(payload.size))
         planned = plan_setpoints(box, outside, payload, 1.0, start, run)
         battery_j = follow(box, outside, payload, 1.0, planned).power_w.sum()
         weighed[minutes] = battery_j + GRID_WEIGHT * planned.precool_grid_j
@@ -369,11 +375,8 @@ def test_pre_cooling_is_counted_at_the_air_it_reaches_without_credit():
     # the capacity there (2.5 kW rated at 0 °C / 30 °C, +2.2 %/K of box air; C_D 0.25, AHRI
     # 210/240), plus the fans' draw: what the answer reports, within 2 %
     box = reference_box()
-    n = 8 * HOUR
-    payload = summer_payload(n)
-    outside = (np.full(n, 30.0), np.full(n, 250.0), summer_doors(n))
-    start = (box.setpoint_c, box.load_c)
-    run = Run(RefrigerationStrategy(strategy="optimal"), np.zeros(n))
+    outside, payload, start = summer_inputs(box)
+    run = Run(RefrigerationStrategy(strategy="optimal"), np.zeros(payload.size))
     planned = plan_setpoints(box, outside, payload, 1.0, start, run)
     air = np.concatenate(([start[0]], planned.depot_air_c))
     goods = np.concatenate(([start[1]], planned.depot_product_c))
