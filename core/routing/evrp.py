@@ -20,8 +20,12 @@ may not serve (pinned to others).
    fleet has vehicles, the routes book them in the order of their first charge there — each
    waits for a point the routes before it leave free, or charges elsewhere
    (:meth:`_Priced.booked`) —, and every solution the search keeps is booked so.
-3. **Search** on work — the route evaluations, by their size (:data:`EVALUATION_S`,
-   :data:`SQUARE_S`) — capped by the deadline (Numba evaluates, Python searches): the
+3. **Search** on work — the routes screened, the route evaluations by their size and the
+   moves (:data:`SCREEN_S`, :data:`EVALUATION_S`, :data:`SQUARE_S`, :data:`MOVE_S`) —
+   capped by the deadline (Numba evaluates, Python searches). A route is screened before its
+   labels: its load, and its windows on the quickest ways between its places, through a
+   station or not (:func:`~core.routing.stations.keeps_windows`; most routes a search tries on
+   a day of tight windows fail there, at a fraction of the labels' time). The
    customers of a route that cannot be charged are inserted where they cost least (left out
    when no vehicle can take them); then, in turn, a vehicle less — the route with the fewest
    customers emptied into the others through an ejection pool (Nagata & Bräysy 2009: a
@@ -45,6 +49,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pyvrp
+from numpy.typing import NDArray
 
 from core.arrays import FloatArray
 from core.routing import pyvrp_run
@@ -55,6 +60,8 @@ from core.routing.stations import (
     Charged,
     RouteFacts,
     Visit,
+    keeps_windows,
+    quickest_durations,
     route_with_stations,
     station_candidates,
 )
@@ -65,15 +72,18 @@ from core.routing.stations import (
 CHARGE_TIME_SHARES = (0.5, 0.0)
 #: Share of the work for step 1.
 ROUTING_SHARE = 0.15
-#: The search's work [reference s]: this much per route evaluated (with its stations) and per
-#: square of its places (the labels compare each station of a gap with the places after it),
-#: fitted on Schneider et al.'s instances on the reference machine (c101: 12 routes of about
-#: 8 customers, 15,500 evaluations a second; r201 and rc201: 4 routes of 25, 3,200).
-EVALUATION_S = 2.8e-5
-SQUARE_S = 2.4e-7
-#: And per ruin-and-recreate move, beyond its evaluations (the remembered ones cost little
-#: but are not free: a small instance whose routes are all remembered still ends).
-MOVE_S = 1e-4
+#: The search's work [reference s]: this much per route screened (its load and windows), per
+#: route evaluated (with its stations) and per square of its places (the labels compare each
+#: station of a gap with the places after it), and per ruin-and-recreate move beyond those (its
+#: insertions' bounds and the remembered routes, which cost little but are not free: a small
+#: instance whose routes are all remembered still ends). Fitted by least squares on the time of
+#: each phase (the search, the attempts at a vehicle less, the polish) of five of Schneider et
+#: al.'s instances (c101, c201, r102, r201, rc103) on the reference machine, checked on seven
+#: others (0.8–1.2 s a second of work).
+SCREEN_S = 1.4e-5
+EVALUATION_S = 1e-5
+SQUARE_S = 3.5e-7
+MOVE_S = 7e-4
 #: PyVRP's integers: costs and times this many per unit.
 _SCALE = 1000
 #: Customers taken out and put back by one ruin-and-recreate move: at most (nearest to a
@@ -83,6 +93,11 @@ RUIN_SIZE = 14
 STRING_SHARE = 0.5
 STRING_MEAN = 10
 STRING_MOST = 10
+#: Share of the moves that ruin the routes around a customer left out, when one is (it goes
+#: back first, into the room made; put back only where its neighbours were, a customer the
+#: starting routes left out could stay out: E-VRPTW's rc108, C19, whose round alone needs a
+#: charge the day has no time for).
+LEFT_SEED_SHARE = 0.5
 #: How often the customers go back at random, the largest demand first, the farthest from the
 #: depot first, the nearest first (SISR's weights 4, 4, 2, 1).
 RECREATE_ORDERS = (4 / 11, 4 / 11, 2 / 11, 1 / 11)
@@ -330,26 +345,26 @@ def _customer_routes(instance: EvrpInstance, effort: Effort, charge_share: float
 
 
 class _Priced:
-    """What each route (kind, customers) costs with its stations, memoised, at the current
-    ``penalty`` per unit of time late (infinite: routes must keep their windows) and with the
-    stations closed when they are (:meth:`booked`: the points the others take too); the
-    evaluations and their sizes, the work they stand for."""
+    """What each route (kind, customers) costs with its stations, memoised, with the
+    stations closed when they are (:meth:`booked`: the points the others take too); the routes
+    screened and evaluated, and the evaluations' sizes, the work they stand for."""
 
     def __init__(self, instance: EvrpInstance) -> None:
         self.instance = instance
-        self.penalty = math.inf
         self.evaluations = 0
         self.squares = 0
+        self.screened = 0
         self.memo: dict[tuple[object, ...], Charged] = {}
         self.facts = [_facts(instance, k) for k in range(len(instance.kinds))]
         stations = np.array(instance.stations, np.int64)
         self.candidates = station_candidates(instance.distance, stations)
+        self.quickest = quickest_durations(instance.duration, self.candidates)
         self.size = len(instance.distance)
         self.closed = Closed.of(instance.closed, self.size)
 
     def charged(self, kind: int, route: list[int], closed: Closed | None = None) -> Charged:
         closed = closed or self.closed
-        key = (self.penalty, kind, tuple(route), closed.key)
+        key = (kind, tuple(route), closed.key)
         if key not in self.memo:
             if len(self.memo) > MEMO_SIZE:
                 self.memo.clear()
@@ -384,23 +399,37 @@ class _Priced:
         vehicle = self.instance.kinds[kind]
         route = vehicle.tidied(route)
         seq = np.array([vehicle.start, *route, 0], dtype=np.int64)
-        self.evaluations += 1
-        self.squares += seq.size**2
-        load = float(self.instance.demand[seq].sum())
+        self.screened += 1
         carried = vehicle.trips_carried(self.instance.demand, route)
         if not carried or not vehicle.forbidden.isdisjoint(route):
             return NO_ROUTE
-        cost, warp, gaps, charges, plugged = route_with_stations(
-            self.facts[kind], seq, self.candidates, closed, self.penalty
-        )
+        f = self.facts[kind]
+        if not keeps_windows(seq, self.quickest, f.ready, f.due, f.service, f.start_time):
+            return NO_ROUTE
+        self.evaluations += 1
+        self.squares += seq.size**2
+        load = float(self.instance.demand[seq].sum())
+        cost, gaps, charges, plugged = route_with_stations(f, seq, self.candidates, closed)
         if not math.isfinite(cost):
             return NO_ROUTE
-        return Charged(float(cost), float(warp), load, seq, gaps, charges, plugged)
+        return Charged(float(cost), load, seq, gaps, charges, plugged)
 
     def cost(self, kind: int, route: list[int]) -> float:
-        """The route's cost with its stations and its penalised lateness; infinite when it
-        cannot hold."""
-        return self.charged(kind, route).cost(self.penalty)
+        """The route's cost with its stations; infinite when it cannot hold."""
+        return self.charged(kind, route).distance
+
+
+@dataclass(frozen=True)
+class _Shape:
+    """A route as :meth:`_Solution._bounds` sees it: its places, load, the ends of its arcs
+    (start to depot), their lengths, and what its stations add to them."""
+
+    members: frozenset[int]
+    load: float
+    head: NDArray[np.int64]
+    tail: NDArray[np.int64]
+    arcs: FloatArray
+    spare: float
 
 
 class _Solution:
@@ -416,6 +445,7 @@ class _Solution:
         self.charged = self.priced.charged
         self.cost = self.priced.cost
         self._booked: tuple[object, list[Charged]] = (None, [])
+        self._shapes: dict[tuple[int, tuple[int, ...]], _Shape] = {}
         inst = instance
         self.nearest = np.argsort(
             inst.distance[np.ix_(inst.customers, inst.customers)], axis=1, kind="stable"
@@ -424,13 +454,14 @@ class _Solution:
             c: {inst.customers[k] for k in self.nearest[n][1 : NEIGHBOURS + 1]}
             for n, c in enumerate(inst.customers)
         }
+        self.position = {c: n for n, c in enumerate(inst.customers)}
         # a customer pinned to a few vehicles joins their routes, neighbours there or not
         self.pinned = frozenset().union(*(kind.forbidden for kind in inst.kinds))
 
     def booked(self) -> list[Charged]:
         """The routes with their stations, the shared points booked (:meth:`_Priced.booked`;
         remembered for the last routes)."""
-        key = (self.priced.penalty, tuple((k, tuple(r)) for k, r in self.routes))
+        key = tuple((k, tuple(r)) for k, r in self.routes)
         if self._booked[0] != key:
             self._booked = (key, self.priced.booked(self.routes))
         return self._booked[1]
@@ -441,8 +472,7 @@ class _Solution:
     def total(self) -> tuple[int, int, float]:
         """Customers left out, vehicles (when they count), cost."""
         vehicles = len(self.routes) if self.instance.fewest_vehicles else 0
-        penalty = self.priced.penalty
-        return len(self.left), vehicles, sum(c.cost(penalty) for c in self.booked())
+        return len(self.left), vehicles, sum(c.distance for c in self.booked())
 
     def _customers(self, route: list[int]) -> list[int]:
         """The customers of ``route`` (not its returns to reload)."""
@@ -491,23 +521,24 @@ class _Solution:
     def _inserted_holding(self, customer: int) -> bool:
         """:meth:`insert` kept only when the routes hold together."""
         saved = self._saved()
-        if self.insert(customer) and self.holds():
+        if self.insert(customer, anywhere=True) and self.holds():
             return True
         self.routes, self.left = saved
         return False
 
-    def insert(self, customer: int, allow_new: bool = True) -> bool:
+    def insert(self, customer: int, allow_new: bool = True, anywhere: bool = False) -> bool:
         """Put ``customer`` where it adds the least cost (a new route of a spare vehicle when
-        none takes it and ``allow_new``); False when nowhere.
+        none takes it and ``allow_new``) — in a route that holds one of its neighbours, or
+        ``anywhere``; False when nowhere.
 
         Positions are tried by a lower bound on what they add — the detour of the customer
-        alone less what the route's stations and lateness cost now (a route with the customer
+        alone less what the route's stations add now (a route with the customer
         drives at least its plain cost) — and the search stops at the first bound no better
         than the best found: the same answer as trying them all, at a fraction of the route
         evaluations."""
         best: tuple[float, list[int]] | None = None
         at = -1
-        for bound, r, k, trip in self._bounds(customer):
+        for bound, r, k, trip in self._bounds(customer, anywhere):
             if best is not None and bound >= best[0] - 1e-9:
                 break
             kind, route = self.routes[r]
@@ -534,33 +565,54 @@ class _Solution:
         self.routes.append((kind, route))
         return True
 
-    def _bounds(self, customer: int) -> list[tuple[float, int, int, bool]]:
-        """Each place in the routes ``customer`` may join (load, a neighbour there) with a
+    def _bounds(self, customer: int, anywhere: bool) -> Iterator[tuple[float, int, int, bool]]:
+        """Each place in the routes ``customer`` may join (load; a neighbour there unless
+        ``anywhere``) with a
         lower bound on what it adds, least first; for a vehicle with trips to spare, also on
         a trip of its own there (a return to reload before it: no shorter, the distances
         being metric)."""
         inst = self.instance
         demand = inst.demand[customer]
         near = self.near[customer]
-        bounds: list[tuple[float, int, int, bool]] = []
+        bounds, routes, places, trips = [], [], [], []
         for r, (kind, route) in enumerate(self.routes):
             vehicle = inst.kinds[kind]
             if customer in vehicle.forbidden:
                 continue
+            shape = self._shape(kind, route)
             one_trip = vehicle.reload < 0  # else each trip's load: evaluated
-            if one_trip and self.charged(kind, route).load + demand > vehicle.capacity:
+            if one_trip and shape.load + demand > vehicle.capacity:
                 continue
-            if customer not in self.pinned and not near.intersection(route):
+            if not anywhere and customer not in self.pinned and near.isdisjoint(shape.members):
                 continue  # no neighbour of it there: it would cost more than where they are
-            seq = np.array([vehicle.start, *route, 0])
-            arcs = inst.distance[seq[:-1], seq[1:]]
-            detour = inst.distance[seq[:-1], customer] + inst.distance[customer, seq[1:]] - arcs
-            spare = self.cost(kind, route) - float(arcs.sum())  # stations and lateness
-            bounds.extend((float(d) - spare, r, k, False) for k, d in enumerate(detour))
-            if not one_trip and route.count(vehicle.reload) < vehicle.max_trips - 1:
-                bounds.extend((float(d) - spare, r, k, True) for k, d in enumerate(detour))
-        bounds.sort()
-        return bounds
+            detour = inst.distance[shape.head, customer] + inst.distance[customer, shape.tail]
+            bound = (detour - shape.arcs) - shape.spare
+            own_trips = not one_trip and route.count(vehicle.reload) < vehicle.max_trips - 1
+            for trip in (False, True)[: 1 + own_trips]:
+                bounds.append(bound)
+                routes.append(np.full(bound.size, r))
+                places.append(np.arange(bound.size))
+                trips.append(np.full(bound.size, trip))
+        if not bounds:
+            return
+        columns = [np.concatenate(c) for c in (bounds, routes, places, trips)]
+        for i in np.lexsort(columns[::-1]):
+            yield float(columns[0][i]), int(columns[1][i]), int(columns[2][i]), bool(columns[3][i])
+
+    def _shape(self, kind: int, route: list[int]) -> _Shape:
+        """What :meth:`_bounds` needs of a route, remembered."""
+        key = (kind, tuple(route))
+        shape = self._shapes.get(key)
+        if shape is None:
+            if len(self._shapes) > MEMO_SIZE:
+                self._shapes.clear()
+            seq = np.array([self.instance.kinds[kind].start, *route, 0])
+            arcs = self.instance.distance[seq[:-1], seq[1:]]
+            charged = self.charged(kind, route)
+            spare = charged.distance - float(arcs.sum())  # the stations' detours
+            shape = _Shape(frozenset(route), charged.load, seq[:-1], seq[1:], arcs, spare)
+            self._shapes[key] = shape
+        return shape
 
     def _saved(self) -> tuple[Routes, list[int]]:
         return [(k, list(r)) for k, r in self.routes], list(self.left)
@@ -580,7 +632,8 @@ class _Search(_Solution):
     def spent_s(self) -> float:
         """The work done [reference s]: route evaluations by their size, and moves."""
         priced = self.priced
-        return EVALUATION_S * priced.evaluations + SQUARE_S * priced.squares + MOVE_S * self.moves
+        labels = EVALUATION_S * priced.evaluations + SQUARE_S * priced.squares
+        return labels + SCREEN_S * priced.screened + MOVE_S * self.moves
 
     def improve(self, work_s: float, effort: Effort) -> SearchEnd:
         """Step 3 for ``work_s`` [reference s], capped by ``effort``'s deadline:
@@ -694,14 +747,17 @@ class _Search(_Solution):
     def _ruin_and_recreate(
         self, threshold: float, new_routes: bool = True, out: Collection[int] = ()
     ) -> None:
-        """A few nearby customers out, each back where it costs least (in a new route of a
-        spare vehicle only with ``new_routes``, then those left out too); kept with no more
-        left out, no vehicle more and a cost at most ``threshold`` (a share) worse. The
-        customers ``out`` (not in the routes) stay out."""
+        """A few nearby customers out — near one left out, :data:`LEFT_SEED_SHARE` of the
+        moves when any is and ``new_routes`` —, those left out put in first (anywhere), then
+        each taken out back where it costs least (in a new route of a spare vehicle only with
+        ``new_routes``); kept with no more left out, no vehicle more and a cost at most
+        ``threshold`` (a share) worse. The customers ``out`` (not in the routes) stay out."""
         self.moves += 1
         saved = self._saved()
         before = self.total()
         seed = int(self.rng.integers(len(self.instance.customers)))
+        if self.left and new_routes and self.rng.random() < LEFT_SEED_SHARE:
+            seed = self.position[self.left[int(self.rng.integers(len(self.left)))]]
         if self.rng.random() < STRING_SHARE:
             taken = self._strings(seed)
         else:
@@ -710,9 +766,9 @@ class _Search(_Solution):
         taken -= set(self.left) | set(out)
         self.routes = [(k, [c for c in r if c not in taken]) for k, r in self.routes]
         self.routes = [(k, r) for k, r in self.routes if self._customers(r)]
+        if new_routes:  # those left out first, into the room made
+            self.left = [c for c in self.left if not self.insert(c, anywhere=True)]
         placed = all(self.insert(c, allow_new=new_routes) for c in self._recreate_order(taken))
-        if new_routes:
-            self.left = [c for c in self.left if not self.insert(c)]
         after = self.total()
         worse = after[:2] > before[:2] or (
             after[:2] == before[:2] and after[2] > before[2] * (1.0 + threshold) + 1e-9
@@ -768,8 +824,7 @@ class _Search(_Solution):
         return shuffled if key is None else sorted(shuffled, key=key)
 
     def restore_best(self) -> None:
-        """The best routes seen, on the routes' own cost (no lateness)."""
-        self.priced.penalty = math.inf
+        """The best routes seen."""
         if self.best is not None and self.best[0] < self.total():
             _, self.routes, self.left = self.best
 

@@ -8,10 +8,9 @@ time. A station closed, or with every point taken by other vehicles, when a char
 start makes the vehicle wait for the first span with room for the whole charge
 (:class:`core.routing.points.Closed`). Labels of cost, time and battery on arrival are kept
 when no other is as good on all three (at most :data:`LABELS_PER_NODE`). The least cost that
-keeps every window, the battery and the latest return wins — or, with a penalty per unit of
-time late, the least cost plus the penalised lateness (Vidal et al.'s time warp, *Computers &
-OR* 40 (2013) 475). The labelling follows Keskin & Çatay, *Transportation Research C* 65 (2016)
-111 (partial recharge) and Schneider, Stenger & Goeke, *Transportation Science* 48 (2014) 500.
+keeps every window, the battery and the latest return wins. The labelling follows Keskin &
+Çatay, *Transportation Research C* 65 (2016) 111 (partial recharge) and Schneider, Stenger &
+Goeke, *Transportation Science* 48 (2014) 500.
 """
 
 from __future__ import annotations
@@ -31,10 +30,10 @@ from core.routing.points import Closed
 STATIONS_PER_GAP = 4
 #: Labels kept at each station (or the start) of a route.
 LABELS_PER_NODE = 6
-#: A label's fields: cost (with the penalised lateness), cost alone, lateness, time, battery on
-#: arrival, the label it came from (node and slot) and what that one charged.
-_C, _D, _W, _T, _B, _PREV, _PREV_L, _X = range(8)
-_FIELDS = 8
+#: A label's fields: cost, time and battery on arrival, the label it came from (node and slot)
+#: and what that one charged.
+_C, _T, _B, _PREV, _PREV_L, _X = range(6)
+_FIELDS = 6
 _EPS = 1e-9
 
 
@@ -80,21 +79,17 @@ class RouteFacts:
 
 @dataclass(frozen=True)
 class Charged:
-    """A route with its stations: its cost, the time it is late in all (``warp``, only with a
-    finite penalty), its load, and per gap between two places of ``seq`` (start, customers,
-    depot) the station visited (−1: none), the energy charged there and when the vehicle is
-    plugged in there (from after any wait to its departure; NaN where none)."""
+    """A route with its stations: its cost, its load, and per gap between two places of
+    ``seq`` (start, customers, depot) the station visited (−1: none), the energy charged there
+    and when the vehicle is plugged in there (from after any wait to its departure; NaN where
+    none)."""
 
     distance: float
-    warp: float
     load: float = 0.0
     seq: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     gaps: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     charges: FloatArray = field(default_factory=lambda: np.zeros(0))
     plugged: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
-
-    def cost(self, penalty: float) -> float:
-        return self.distance + (penalty * self.warp if self.warp > 0 else 0.0)
 
     @property
     def visits(self) -> list[Visit]:
@@ -117,7 +112,7 @@ class Charged:
         ]
 
 
-NO_ROUTE = Charged(math.inf, 0.0)
+NO_ROUTE = Charged(math.inf)
 
 
 def station_candidates(cost: FloatArray, stations: NDArray[np.int64]) -> NDArray[np.int64]:
@@ -129,19 +124,52 @@ def station_candidates(cost: FloatArray, stations: NDArray[np.int64]) -> NDArray
     return stations[best]
 
 
+def quickest_durations(duration: FloatArray, candidates: NDArray[np.int64]) -> FloatArray:
+    """Each arc's least time between its two places whatever a route charges on it: straight,
+    or through one of its candidate stations (a gap holds at most one; plugging in, charging
+    and waiting only add to it) [the duration's unit] — a lower bound for
+    :func:`keeps_windows`."""
+    if candidates.shape[2] == 0:
+        return duration
+    size = duration.shape[0]
+    rows = np.arange(size)[:, None, None]
+    cols = np.arange(size)[None, :, None]
+    through = duration[rows, candidates] + duration[candidates, cols]
+    return np.minimum(duration, through.min(axis=2))
+
+
+@njit(cache=True)
+def keeps_windows(
+    seq: NDArray[np.int64],
+    quickest: FloatArray,
+    ready: FloatArray,
+    due: FloatArray,
+    service: FloatArray,
+    start_time: float,
+) -> bool:
+    """Whether ``seq`` can keep its windows at all: driven on the ``quickest`` times
+    (:func:`quickest_durations`), charging nothing, it reaches no place after its window.
+    False is a proof that no stations and charges keep them (most of the routes a search
+    tries on a day of tight windows fail so, in a fraction of the labels' time)."""
+    clock = start_time
+    for p in range(1, seq.size):
+        clock += quickest[seq[p - 1], seq[p]]
+        if clock > due[seq[p]] + _EPS:
+            return False
+        clock = max(clock, ready[seq[p]]) + service[seq[p]]
+    return True
+
+
 def route_with_stations(
     facts: RouteFacts,
     seq: NDArray[np.int64],
     candidates: NDArray[np.int64],
     closed: Closed,
-    penalty: float = math.inf,
-) -> tuple[float, float, NDArray[np.int64], FloatArray, FloatArray]:
+) -> tuple[float, NDArray[np.int64], FloatArray, FloatArray]:
     """``seq`` (start, customers in order, depot) with the stations and charges it needs at
-    the least cost, plus ``penalty`` per unit of time late (a place reached after its window
-    is served at its close, the lateness counted; infinite: never late), a charge only where
-    and when ``closed`` has room for it: its cost, lateness, and per gap the station (−1:
-    none), the energy charged there and when plugged in (from, to). Infinite cost when no
-    choice keeps the battery (and the windows)."""
+    the least cost within every window, a charge only where and when ``closed`` has room for
+    it: its cost, and per gap the station (−1: none), the energy charged there and when
+    plugged in (from, to). Infinite cost when no choice keeps the battery and the windows."""
     f = facts
     lab = np.zeros((1 + (seq.size - 1) * candidates.shape[2], LABELS_PER_NODE, _FIELDS))
     return _labels(
@@ -157,7 +185,6 @@ def route_with_stations(
         f.battery,
         f.initial,
         f.start_time,
-        penalty,
         (closed.ptr, closed.start, closed.end),
         lab,
     )
@@ -192,10 +219,9 @@ def _labels(
     battery: float,
     initial: float,
     start_time: float,
-    penalty: float,
     closed: tuple[NDArray[np.int64], FloatArray, FloatArray],
     lab: FloatArray,
-) -> tuple[float, float, NDArray[np.int64], FloatArray, FloatArray]:
+) -> tuple[float, NDArray[np.int64], FloatArray, FloatArray]:
     """Labels over the route's charge points — the start (node 0), then station k of gap p
     (between ``seq[p]`` and ``seq[p + 1]``, node ``1 + p·K + k``), each extended in turn
     (:func:`_extend`); the best that reaches the depot, traced back (:func:`_traced`)."""
@@ -206,21 +232,21 @@ def _labels(
     lab[0, 0, _B] = initial
     lab[0, 0, _PREV] = -1.0
     count[0] = 1
-    _first_stations(seq, cost, dur, energy, due, cand, penalty, lab, count)
-    best = np.array([np.inf, 0.0, 0.0, -1.0, -1.0, 0.0])  # cost, d, w, node, slot, charge
+    _first_stations(seq, cost, dur, energy, due, cand, lab, count)
+    best = np.array([np.inf, -1.0, -1.0, 0.0])  # cost, node, slot, charge
     for u in range(nodes):
         for li in range(count[u]):
             _extend(
                 u, li, seq, cost, dur, energy, ready, due, service, charge_time, cand,
-                battery, penalty, closed, lab, count, best,
+                battery, closed, lab, count, best,
             )  # fmt: skip
     gaps = np.full(m, -1, dtype=np.int64)
     charges = np.zeros(m)
     plugged = np.full((m, 2), np.nan)
-    if best[3] < 0:
-        return np.inf, 0.0, gaps, charges, plugged
+    if best[1] < 0:
+        return np.inf, gaps, charges, plugged
     _traced(best, lab, seq, cand, (service, charge_time, closed), (gaps, charges, plugged))
-    return best[1], best[2], gaps, charges, plugged
+    return best[0], gaps, charges, plugged
 
 
 @njit(cache=True)
@@ -231,7 +257,6 @@ def _first_stations(
     energy: FloatArray,
     due: FloatArray,
     cand: NDArray[np.int64],
-    penalty: float,
     lab: FloatArray,
     count: NDArray[np.int64],
 ) -> None:
@@ -241,12 +266,8 @@ def _first_stations(
     for k in range(cand.shape[2]):
         s = cand[seq[0], seq[1], k]
         arrive = t0 + dur[here, s]
-        late = max(arrive - due[end], 0.0)
-        if energy[here, s] <= b0 + _EPS and not (not np.isfinite(penalty) and late > _EPS):
-            _add_label(
-                lab, count, 1 + k, cost[here, s], late, min(arrive, due[end]),
-                b0 - energy[here, s], penalty, 0, 0, 0.0,
-            )  # fmt: skip
+        if energy[here, s] <= b0 + _EPS and arrive <= due[end]:
+            _add_label(lab, count, 1 + k, cost[here, s], arrive, b0 - energy[here, s], 0, 0, 0.0)
 
 
 @njit(cache=True)
@@ -263,7 +284,6 @@ def _extend(
     charge_time: FloatArray,
     cand: NDArray[np.int64],
     battery: float,
-    penalty: float,
     closed: tuple[NDArray[np.int64], FloatArray, FloatArray],
     lab: FloatArray,
     count: NDArray[np.int64],
@@ -275,8 +295,7 @@ def _extend(
     m = seq.size - 1
     k_max = cand.shape[2]
     end = seq[m]
-    hard = not np.isfinite(penalty)
-    d0, w0, t0, b0 = lab[u, li, _D], lab[u, li, _W], lab[u, li, _T], lab[u, li, _B]
+    d0, t0, b0 = lab[u, li, _C], lab[u, li, _T], lab[u, li, _B]
     if u == 0:
         here, first, limit, plug = seq[0], 1, b0, 0.0
     else:
@@ -297,12 +316,10 @@ def _extend(
             if not np.isfinite(leave):
                 return
             _, late = _walk(seq, first, m, here, leave, dur, ready, due, service)
-            if hard and late > _EPS:
+            if late > 0.0:
                 return
-            c = d0 + path + (penalty * (w0 + late) if w0 + late > 0 else 0.0)
-            if c < best[0]:
-                best[0], best[1], best[2] = c, d0 + path, w0 + late
-                best[3], best[4], best[5] = u, li, x
+            if d0 + path < best[0]:
+                best[0], best[1], best[2], best[3] = d0 + path, u, li, x
             return
         for k in range(k_max):
             s = cand[node, seq[p + 1], k]
@@ -315,12 +332,11 @@ def _extend(
                 continue
             leave, late = _walk(seq, first, p, here, leave, dur, ready, due, service)
             arrive = leave + dur[node, s]
-            late += max(arrive - due[end], 0.0)
-            if hard and late > _EPS:
+            if late > 0.0 or arrive > due[end]:
                 continue
             _add_label(
-                lab, count, 1 + p * k_max + k, d0 + path + cost[node, s], w0 + late,
-                min(arrive, due[end]), b0 + x - to_s, penalty, u, li, x,
+                lab, count, 1 + p * k_max + k, d0 + path + cost[node, s], arrive,
+                b0 + x - to_s, u, li, x,
             )  # fmt: skip
 
 
@@ -361,7 +377,7 @@ def _traced(
     service, charge_time, closed = at
     gaps, charges, plugged = out
     k_max = cand.shape[2]
-    u, li, x = int(best[3]), int(best[4]), best[5]
+    u, li, x = int(best[1]), int(best[2]), best[3]
     while u > 0:
         gap = (u - 1) // k_max
         here = cand[seq[gap], seq[gap + 1], (u - 1) % k_max]
@@ -409,18 +425,15 @@ def _add_label(
     lab: FloatArray,
     count: NDArray[np.int64],
     v: int,
-    d: float,
-    w: float,
+    c: float,
     t: float,
     b: float,
-    penalty: float,
     u: int,
     li: int,
     x: float,
 ) -> None:
     """Keep the label at node ``v`` unless one there is as good on cost, time and battery;
     drop those it is as good as; at most the labels' room (the costliest goes)."""
-    c = d + (penalty * w if w > 0 else 0.0)
     n = count[v]
     for i in range(n):
         if lab[v, i, _C] <= c + _EPS and lab[v, i, _T] <= t + _EPS and lab[v, i, _B] >= b - _EPS:
@@ -444,8 +457,6 @@ def _add_label(
     else:
         keep += 1
     lab[v, slot, _C] = c
-    lab[v, slot, _D] = d
-    lab[v, slot, _W] = w
     lab[v, slot, _T] = t
     lab[v, slot, _B] = b
     lab[v, slot, _PREV] = u

@@ -1,7 +1,8 @@
 """Routing with recharging stations (core/routing/evrp.py): a route on a line whose charges
-and times are worked by hand, a window that charging makes unreachable, the lateness a
-penalty counts, a small instance against every split and order, and the benchmark command on
-a shared instance, its answer checked by the rules alone (testbed/evrptw.py)."""
+and times are worked by hand, a window that charging makes unreachable (and one the way
+alone does, screened before the labels), a small instance against every split and order,
+and the benchmark command on a shared instance, its answer checked by the rules alone
+(testbed/evrptw.py)."""
 
 from __future__ import annotations
 
@@ -18,8 +19,14 @@ import numpy as np
 import pytest
 
 from core.routing.effort import Effort
-from core.routing.evrp import EvrpInstance, VehicleKind, _Priced, _Search, solve_evrptw
-from core.routing.stations import NO_ROUTE
+from core.routing.evrp import EvrpInstance, VehicleKind, _Priced, _Search, _Solution, solve_evrptw
+from core.routing.stations import (
+    NO_ROUTE,
+    keeps_windows,
+    quickest_durations,
+    route_with_stations,
+    station_candidates,
+)
 from testbed.evrptw import FOLDER, check, read
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -62,10 +69,8 @@ def on_a_line(**changes) -> EvrpInstance:
     return instance([(0, 0), (40, 0), (20, 0)], "dcf", **changes)
 
 
-def charged(inst: EvrpInstance, route: list[int], penalty: float = math.inf):
-    priced = _Priced(inst)
-    priced.penalty = penalty
-    return priced.charged(0, route)
+def charged(inst: EvrpInstance, route: list[int]):
+    return _Priced(inst).charged(0, route)
 
 
 def test_a_route_on_a_line_charges_what_the_way_to_the_next_charge_takes():
@@ -80,7 +85,6 @@ def test_a_route_on_a_line_charges_what_the_way_to_the_next_charge_takes():
         (2, pytest.approx(20.0)),
         (0, 0.0),
     ]
-    assert result.warp == 0.0
 
 
 def test_a_vehicle_leaving_with_less_charges_more_at_the_first_station():
@@ -125,11 +129,63 @@ def test_a_window_that_charging_makes_unreachable_is_no_route():
     due = np.array([1000.0, 60.0, 1000.0])
     assert charged(on_a_line(due=due), [1]).distance == pytest.approx(80.0)
     late = np.array([1000.0, 50.0, 1000.0])
-    assert charged(on_a_line(due=late), [1]) is NO_ROUTE
-    # with a penalty per unit of time late it is a route 10 late, served at its close
-    penalised = charged(on_a_line(due=late), [1], penalty=3.0)
-    assert penalised.warp == pytest.approx(10.0)
-    assert penalised.cost(3.0) == pytest.approx(80.0 + 30.0)
+    priced = _Priced(on_a_line(due=late))
+    assert priced.charged(0, [1]) is NO_ROUTE
+    # the way alone (40) keeps this window: the labels found that charging breaks it
+    assert (priced.screened, priced.evaluations) == (1, 1)
+
+
+def test_a_window_the_way_alone_cannot_keep_is_screened_without_labels():
+    # the customer 40 out cannot be reached by 30 however the vehicle charges
+    priced = _Priced(on_a_line(due=np.array([1000.0, 30.0, 1000.0])))
+    assert priced.charged(0, [1]) is NO_ROUTE
+    assert (priced.screened, priced.evaluations) == (1, 0)
+
+
+def test_the_quickest_way_between_two_places_may_pass_a_station():
+    # depot, customer, station: the road straight takes 10, through the station 3 + 4
+    duration = np.array([[0.0, 10.0, 3.0], [10.0, 0.0, 4.0], [3.0, 4.0, 0.0]])
+    candidates = station_candidates(duration, np.array([2]))
+    quickest = quickest_durations(duration, candidates)
+    assert quickest[0, 1] == quickest[1, 0] == 7.0
+    assert quickest[0, 2] == 3.0 and quickest[2, 1] == 4.0
+    # a window closing at 8 is kept through the station, not on the road straight
+    due, ready, service = np.array([100.0, 8.0, 100.0]), np.zeros(3), np.zeros(3)
+    seq = np.array([0, 1, 0])
+    assert keeps_windows(seq, quickest, ready, due, service, 0.0)
+    assert not keeps_windows(seq, duration, ready, due, service, 0.0)
+    # waiting for a window to open and serving count: ready 6, service 2, back by 14
+    assert keeps_windows(seq, quickest, np.array([0, 6.0, 0]), due, np.array([0, 2.0, 0]), 0.0)
+    late = np.array([14.0, 8.0, 100.0])
+    assert not keeps_windows(seq, quickest, np.array([0, 6.0, 0]), late, np.array([0, 2, 0]), 0.0)
+
+
+def test_the_screen_never_refuses_a_route_the_labels_find():
+    # a day whose roads are quicker through its stations (not metric in time), tight
+    # windows: every route of up to five customers the labels find keeps the screen; the
+    # screen refuses a good share of the others (else it would test nothing)
+    rng = np.random.default_rng(2)
+    xy = rng.uniform(-30, 30, (12, 2))
+    xy[0] = 0.0
+    inst = instance([tuple(p) for p in xy], "dccccccccfff", battery=60.0, time_per_energy=0.5)
+    duration = inst.duration.copy()
+    duration[:, 9:] *= 0.3  # the ways to and from the stations are fast roads
+    duration[9:, :] *= 0.3
+    ready = rng.uniform(0, 60, 12)
+    inst = replace(inst, duration=duration, ready=ready, due=ready + rng.uniform(10, 60, 12))
+    inst.due[0] = 300.0
+    priced = _Priced(inst)
+    facts = priced.facts[0]
+    found = refused = 0
+    for _ in range(3000):
+        route = [int(c) for c in rng.permutation(inst.customers)[: rng.integers(1, 6)]]
+        seq = np.array([0, *route, 0])
+        cost, *_ = route_with_stations(facts, seq, priced.candidates, priced.closed)
+        kept = keeps_windows(seq, priced.quickest, inst.ready, facts.due, inst.service, 0.0)
+        found += math.isfinite(cost)
+        refused += not kept
+        assert kept or not math.isfinite(cost), route
+    assert found > 100 and refused > 1000
 
 
 def test_each_kind_charges_at_its_own_time_per_energy():
@@ -373,6 +429,20 @@ def test_a_route_is_emptied_by_taking_out_a_customer_that_fits_elsewhere():
     routes = sorted(sorted(route) for _, route in search.routes)
     assert routes == [[1, 2, 6], [3, 4, 5]]
     assert search.holds() and search.left == []
+
+
+def test_a_customer_left_out_may_go_anywhere_the_others_only_near_their_neighbours():
+    # the customer at (50, 1) has its 15 nearest in the east route, full (15 of 15); the
+    # west route has room but none of them: only a customer left out (anywhere) goes there
+    east = [(50.0 + (k % 4) * 0.5, (k // 4) * 0.5 - 1.0) for k in range(15)]
+    west = [(-50.0, 0.0), (-50.0, 2.0)]
+    inst = instance([(0, 0), *east, *west, (50.0, 1.2)], "d" + "c" * 18, capacity=15.0,
+                    battery=1000.0)  # fmt: skip
+    solution = _Solution(inst)
+    solution.routes = [(0, list(range(1, 16))), (0, [16, 17])]
+    assert not solution.insert(18, allow_new=False)
+    assert solution.insert(18, allow_new=False, anywhere=True)
+    assert 18 in solution.routes[1][1]
 
 
 def test_a_string_ruin_takes_one_run_of_consecutive_customers_from_each_route_it_ruins():
