@@ -202,7 +202,9 @@ def warm_up() -> None:
         np.full(size, 0.1), 1.5, 1.5, 0.0,
     )  # fmt: skip
     candidates = station_candidates(cost, np.array([3]))
-    route_with_stations(facts, np.array([0, 1, 2, 0]), candidates, Closed.of({3: [(0.0, 1.0)]}, 4))
+    seq = np.array([0, 1, 2, 0])
+    route_with_stations(facts, seq, candidates, Closed.of({3: [(0.0, 1.0)]}, 4))
+    keeps_windows(seq, cost, facts.ready, facts.due, facts.service, 0.0)
 
 
 @njit(cache=True)
