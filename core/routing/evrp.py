@@ -20,8 +20,8 @@ may not serve (pinned to others).
    fleet has vehicles, the routes book them in the order of their first charge there — each
    waits for a point the routes before it leave free, or charges elsewhere
    (:meth:`_Priced.booked`) —, and every solution the search keeps is booked so.
-3. **Search** on work — the routes screened, the route evaluations by their size and the
-   moves (:data:`SCREEN_S`, :data:`EVALUATION_S`, :data:`SQUARE_S`, :data:`MOVE_S`) —
+3. **Search** on work — the routes screened and evaluated, the labels' steps and the moves
+   (:data:`SCREEN_S`, :data:`EVALUATION_S`, :data:`LOOK_S`, :data:`WALK_S`, :data:`MOVE_S`) —
    capped by the deadline (Numba evaluates, Python searches). A route is screened before its
    labels: its load, and its windows on the quickest ways between its places, through a
    station or not (:func:`~core.routing.stations.keeps_windows`; most routes a search tries on
@@ -73,17 +73,21 @@ CHARGE_TIME_SHARES = (0.5, 0.0)
 #: Share of the work for step 1.
 ROUTING_SHARE = 0.15
 #: The search's work [reference s]: this much per route screened (its load and windows), per
-#: route evaluated (with its stations) and per square of its places (the labels compare each
-#: station of a gap with the places after it), and per ruin-and-recreate move beyond those (its
-#: insertions' bounds and the remembered routes, which cost little but are not free: a small
-#: instance whose routes are all remembered still ends). Fitted by least squares on the time of
-#: each phase (the search, the attempts at a vehicle less, the polish) of five of Schneider et
-#: al.'s instances (c101, c201, r102, r201, rc103) on the reference machine, checked on seven
-#: others (0.8–1.2 s a second of work).
-SCREEN_S = 1.4e-5
-EVALUATION_S = 1e-5
-SQUARE_S = 3.5e-7
-MOVE_S = 7e-4
+#: route evaluated (with its stations), per station its labels look at and per place they walk
+#: past (a label drives on through the places of the route its battery reaches, to each of
+#: their stations, walking the windows from the label's place to each: long routes with few
+#: charges cost more per evaluation than their size says), and per ruin-and-recreate move
+#: beyond those (its insertions' bounds and the remembered routes, which cost little but are
+#: not free: a small instance whose routes are all remembered still ends). Fitted by least
+#: squares on the time of each phase (the searches, the polish) of ten of Schneider et al.'s
+#: instances (c101, c108, c201, r102, r110, r201, r211, rc103, rc201, rc208) and the Vienna
+#: day with chargers (2 routes of 40 stops) on the reference machine, twice each: 0.7–1.3 s a
+#: second of work, the run-to-run noise of the same work on it (±30 %).
+SCREEN_S = 6e-6
+EVALUATION_S = 1.8e-5
+LOOK_S = 5.8e-8
+WALK_S = 3.5e-9
+MOVE_S = 9e-4
 #: PyVRP's integers: costs and times this many per unit.
 _SCALE = 1000
 #: Customers taken out and put back by one ruin-and-recreate move: at most (nearest to a
@@ -352,7 +356,7 @@ class _Priced:
     def __init__(self, instance: EvrpInstance) -> None:
         self.instance = instance
         self.evaluations = 0
-        self.squares = 0
+        self.steps = np.zeros(2, dtype=np.int64)  # stations looked at, places walked
         self.screened = 0
         self.memo: dict[tuple[object, ...], Charged] = {}
         self.facts = [_facts(instance, k) for k in range(len(instance.kinds))]
@@ -407,9 +411,10 @@ class _Priced:
         if not keeps_windows(seq, self.quickest, f.ready, f.due, f.service, f.start_time):
             return NO_ROUTE
         self.evaluations += 1
-        self.squares += seq.size**2
         load = float(self.instance.demand[seq].sum())
-        cost, gaps, charges, plugged = route_with_stations(f, seq, self.candidates, closed)
+        cost, gaps, charges, plugged = route_with_stations(
+            f, seq, self.candidates, closed, self.steps
+        )
         if not math.isfinite(cost):
             return NO_ROUTE
         return Charged(float(cost), load, seq, gaps, charges, plugged)
@@ -630,9 +635,11 @@ class _Search(_Solution):
 
     @property
     def spent_s(self) -> float:
-        """The work done [reference s]: route evaluations by their size, and moves."""
+        """The work done [reference s]: routes screened and evaluated, the labels' steps,
+        and moves."""
         priced = self.priced
-        labels = EVALUATION_S * priced.evaluations + SQUARE_S * priced.squares
+        looked, walked = priced.steps.tolist()
+        labels = EVALUATION_S * priced.evaluations + LOOK_S * looked + WALK_S * walked
         return labels + SCREEN_S * priced.screened + MOVE_S * self.moves
 
     def improve(self, work_s: float, effort: Effort) -> SearchEnd:
@@ -833,13 +840,16 @@ class _Search(_Solution):
         routes cheaper and keeps them holding together, until none does — a route's stretch of
         customers turned round (2-opt), or two routes' ends exchanged (2-opt*: what ruin and
         recreate, moving customers one by one, does not do: a van's last stretch, charges
-        and all, handed to another). The deadline is looked at before each change tried: one
-        pass over two long routes' ends takes seconds. A pass it cuts has changed nothing, so
-        a replay stopping before that pass ends the same."""
+        and all, handed to another). The work and the deadline are looked at before each
+        change tried: one pass over two long routes' ends takes seconds (the last pass, which
+        finds nothing, took four times the polish's work on E-VRPTW's r2). A pass either cuts
+        has changed nothing, so a replay stopping before that pass ends the same."""
         end = self.spent_s + work_s
         watch = effort.watch()
-        while self.spent_s < end:
+        while True:
             for changed, now in self._changes():
+                if self.spent_s >= end:
+                    return "work"
                 if watch.passed(self.moves):
                     return "time_limit"
                 if self._kept(changed, now):
@@ -847,7 +857,6 @@ class _Search(_Solution):
                     break
             else:
                 return "work"
-        return "work"
 
     def _changes(self) -> Iterator[tuple[list[tuple[int, list[int]]], float]]:
         """Each change :meth:`polish` tries, in order, with what the routes it changes cost

@@ -165,11 +165,13 @@ def route_with_stations(
     seq: NDArray[np.int64],
     candidates: NDArray[np.int64],
     closed: Closed,
+    steps: NDArray[np.int64] | None = None,
 ) -> tuple[float, NDArray[np.int64], FloatArray, FloatArray]:
     """``seq`` (start, customers in order, depot) with the stations and charges it needs at
     the least cost within every window, a charge only where and when ``closed`` has room for
     it: its cost, and per gap the station (−1: none), the energy charged there and when
-    plugged in (from, to). Infinite cost when no choice keeps the battery and the windows."""
+    plugged in (from, to). Infinite cost when no choice keeps the battery and the windows.
+    ``steps`` (when given) counts the labels' work: the stations looked at, the places walked."""
     f = facts
     lab = np.zeros((1 + (seq.size - 1) * candidates.shape[2], LABELS_PER_NODE, _FIELDS))
     return _labels(
@@ -187,6 +189,7 @@ def route_with_stations(
         f.start_time,
         (closed.ptr, closed.start, closed.end),
         lab,
+        np.zeros(2, dtype=np.int64) if steps is None else steps,
     )
 
 
@@ -223,6 +226,7 @@ def _labels(
     start_time: float,
     closed: tuple[NDArray[np.int64], FloatArray, FloatArray],
     lab: FloatArray,
+    steps: NDArray[np.int64],
 ) -> tuple[float, NDArray[np.int64], FloatArray, FloatArray]:
     """Labels over the route's charge points — the start (node 0), then station k of gap p
     (between ``seq[p]`` and ``seq[p + 1]``, node ``1 + p·K + k``), each extended in turn
@@ -240,7 +244,7 @@ def _labels(
         for li in range(count[u]):
             _extend(
                 u, li, seq, cost, dur, energy, ready, due, service, charge_time, cand,
-                battery, closed, lab, count, best,
+                battery, closed, lab, count, best, steps,
             )  # fmt: skip
     gaps = np.full(m, -1, dtype=np.int64)
     charges = np.zeros(m)
@@ -290,10 +294,12 @@ def _extend(
     lab: FloatArray,
     count: NDArray[np.int64],
     best: FloatArray,
+    steps: NDArray[np.int64],
 ) -> None:
     """Label ``li`` of node ``u`` driven on: to each candidate station of each later gap it
     reaches, charging at ``u`` what the way there takes beyond its battery (a new label), and
-    to the depot (the best so far). The start charges nothing."""
+    to the depot (the best so far). The start charges nothing. ``steps`` counts the stations
+    looked at and the places walked (their time)."""
     m = seq.size - 1
     k_max = cand.shape[2]
     end = seq[m]
@@ -317,6 +323,7 @@ def _extend(
             leave = _plugged(u, here, t0, plug + charge_time[here] * x, closed)[1]
             if not np.isfinite(leave):
                 return
+            steps[1] += m - first + 1
             _, late = _walk(seq, first, m, here, leave, dur, ready, due, service)
             if late > 0.0:
                 return
@@ -324,6 +331,7 @@ def _extend(
                 best[0], best[1], best[2], best[3] = d0 + path, u, li, x
             return
         for k in range(k_max):
+            steps[0] += 1
             s = cand[node, seq[p + 1], k]
             to_s = used + energy[node, s]
             if to_s > limit + _EPS:
@@ -332,6 +340,7 @@ def _extend(
             leave = _plugged(u, here, t0, plug + charge_time[here] * x, closed)[1]
             if not np.isfinite(leave):
                 continue
+            steps[1] += p - first + 1
             leave, late = _walk(seq, first, p, here, leave, dur, ready, due, service)
             arrive = leave + dur[node, s]
             if late > 0.0 or arrive > due[end]:

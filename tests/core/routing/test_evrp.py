@@ -87,6 +87,16 @@ def test_a_route_on_a_line_charges_what_the_way_to_the_next_charge_takes():
     ]
 
 
+def test_the_labels_work_is_counted_by_the_stations_looked_at_and_the_places_walked():
+    # From the start (battery 50) the customer (40) is reached and its station is looked at
+    # (60 > 50: no label); the station before the customer (30 left) reaches the customer, looks
+    # at the station after it (a label: the customer walked) and cannot reach the depot (60);
+    # from the station after the customer the depot is walked to. Two looks, two places walked.
+    priced = _Priced(on_a_line())
+    assert priced.charged(0, [1]).distance == pytest.approx(80.0)
+    assert priced.steps.tolist() == [2, 2]
+
+
 def test_a_vehicle_leaving_with_less_charges_more_at_the_first_station():
     # leaving with 30 of 50: D→S leaves 10; S→C→S takes 40: charge 30 (40 ≤ 50 on leaving);
     # S→D takes 20: charge 20. The start charges nothing (no station there).
