@@ -11,7 +11,7 @@ from benchmarks.common import best_time_s, print_table
 from core.arrays import keep_heap
 from core.params import PRESETS, STREET_TYPES, DoorOpening, Interval, Location, Weather
 from core.physics.cycles import generate_leg, load_cycle_csv
-from core.physics.simulate import simulate
+from core.physics.simulate import Along, simulate
 from core.physics.weather import HourlyWeather
 from testbed.reference import REFERENCE
 
@@ -87,11 +87,10 @@ def main() -> None:
                     START,
                     VIENNA,
                     van,
-                    payload_kg=payload,
                     weather=weather,
-                    door_openings=doors,
-                    parked=parked,
-                    heading_deg=headings,
+                    along=Along(
+                        payload_kg=payload, door_openings=doors, parked=parked, heading_deg=headings
+                    ),
                 )
 
             seconds = best_time_s(run, repeat=15, number=5)
@@ -124,7 +123,9 @@ def main() -> None:
     zoe = PRESETS["reference-zoe"].van()
     for name, reference in FASTSIM_WH_KM.items():
         cycle = load_cycle_csv(REFERENCE / "cycles" / f"{name}.csv")
-        result = simulate(cycle.speed_mps, cycle.dt_s, START, VIENNA, zoe, grade=cycle.grade)
+        result = simulate(
+            cycle.speed_mps, cycle.dt_s, START, VIENNA, zoe, along=Along(grade=cycle.grade)
+        )
         ours = result.energy_kwh["traction"] * 1e6 / result.distance_m
         rows.append(
             [

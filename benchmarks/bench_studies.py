@@ -10,7 +10,7 @@ import numpy as np
 from benchmarks.common import best_time_s, print_table
 from core.params import Depot, Location, Stop, VanParams, Weather
 from core.planning.model import PlanProblem
-from core.planning.studies import Season, scenario_grid, speed_sweep
+from core.planning.studies import GridAxes, Season, SweepTrips, scenario_grid, speed_sweep
 
 
 def main() -> None:
@@ -19,7 +19,7 @@ def main() -> None:
     speeds = [float(v) for v in range(20, 121, 10)]
     sweep_s = best_time_s(
         lambda: speed_sweep(
-            speeds, 20_000, noon, vienna, VanParams(), Weather(t_min_c=20, t_max_c=32)
+            speeds, SweepTrips(20_000), noon, vienna, VanParams(), Weather(t_min_c=20, t_max_c=32)
         )
     )
     rng = np.random.default_rng(8)
@@ -45,7 +45,8 @@ def main() -> None:
         for name, month in (("winter", 1), ("spring", 4), ("summer", 7))
     ]
     grid_s = best_time_s(
-        lambda: scenario_grid(problem, seasons, [0.2, 0.5, 1.0], [0.2, 0.5, 0.8]), repeat=3
+        lambda: scenario_grid(problem, GridAxes(seasons, [0.2, 0.5, 1.0], [0.2, 0.5, 0.8])),
+        repeat=3,
     )
     print_table(
         "Studies (core, one process)",

@@ -39,7 +39,7 @@ from core.physics.cycles import generate_leg
 from core.physics.simulate import CONSUMERS, simulate
 from core.planning.model import PlanProblem, PlanResult
 from core.planning.round.planner import plan
-from core.planning.studies import Season, scenario_grid, speed_sweep
+from core.planning.studies import GridAxes, Season, SweepTrips, scenario_grid, speed_sweep
 
 COLORS = {
     "traction": "#4c72b0",
@@ -244,7 +244,7 @@ def _driving(result: PlanResult) -> dict[str, float]:
 def study(preset: str, drivers: list[float], progress: Any = None) -> VanStudy:
     """The seasons × drivers grid, the winter round and the urban leg of one van."""
     grid_result = scenario_grid(
-        _round(SUMMER, preset=preset), [WINTER, SUMMER], drivers, [None], progress=progress
+        _round(SUMMER, preset=preset), GridAxes([WINTER, SUMMER], drivers, [None]), progress
     )
     return VanStudy(
         grid={(c.season, c.driver_aggressiveness): c.energy_kwh for c in grid_result.cells},
@@ -462,16 +462,15 @@ def main(argv: list[str] | None = None) -> Path:
             ("free flow", 0.0, None),
             ("dense traffic", NORMAL_DRIVER, 0.8),
         ):
-            point = speed_sweep(
-                [80.0], 30_000, start, VIENNA, van, season.weather, driver, density
-            ).points[0]
+            trips = SweepTrips(30_000, driver, density)
+            point = speed_sweep([80.0], trips, start, VIENNA, van, season.weather).points[0]
             traffic_rows.append((f"{season.name}\n{label}", point.energy_wh_per_km))
 
     speeds = [20, 40, 60, 80, 100, 120] if args.quick else list(range(20, 121, 5))
     start, _ = departure(SUMMER.date, dt.time(12), "Europe/Vienna", VIENNA.lon)
     sweep = speed_sweep(
         [float(s) for s in tqdm(speeds, desc="speed sweep", unit="speed")],
-        20_000,
+        SweepTrips(20_000),
         start,
         VIENNA,
         van,

@@ -19,7 +19,7 @@ from core.params import STREET_TYPES, CargoBoxParams, VanParams
 from core.physics.cargo import BoxResult
 from core.physics.cold_chain import box_check
 from core.physics.cycles import generate_leg
-from core.physics.simulate import check_trace, simulate
+from core.physics.simulate import Along, check_trace, simulate
 from core.physics.weather import forecast_for
 from core.planning.model import ColdChainResult
 
@@ -73,11 +73,13 @@ def simulate_trace(request: SimulateRequest, settings: Settings) -> SimulateResp
         request.start,
         request.location,
         van,
-        grade=request.grade,
         weather=forecast,
-        door_openings=request.door_openings,
-        parked=request.parked,
-        air_setpoints=request.air_setpoints,
+        along=Along(
+            grade=request.grade,
+            door_openings=request.door_openings,
+            parked=request.parked,
+            air_setpoints=request.air_setpoints,
+        ),
     )
     km = result.distance_m / 1000
     # Per-km figures of a trace that (nearly) stands still mean nothing: null below a metre.

@@ -20,7 +20,14 @@ from app.schemas.studies import (
 from app.settings import Settings
 from core.clock import departure
 from core.exceptions import CoreError, LimitExceededError, TooMuchToWaitForError
-from core.planning.studies import check_seasons, default_seasons, scenario_grid, speed_sweep
+from core.planning.studies import (
+    GridAxes,
+    SweepTrips,
+    check_seasons,
+    default_seasons,
+    scenario_grid,
+    speed_sweep,
+)
 
 
 def sweep_start(request: SpeedSweepRequest, settings: Settings) -> dt.datetime:
@@ -56,16 +63,13 @@ def sweep_speeds(request: SpeedSweepRequest, settings: Settings) -> SpeedSweepRe
             "speeds_kmh",
         )
     try:
-        sweep = speed_sweep(
-            request.speeds_kmh,
-            request.distance_m,
-            start,
-            request.location,
-            van_of(request, settings),
-            request.weather,
-            request.driver_aggressiveness,
-            request.traffic_density,
+        trips = SweepTrips(
+            request.distance_m, request.driver_aggressiveness, request.traffic_density
         )
+        sweep = speed_sweep(
+            request.speeds_kmh, trips, start, request.location, van_of(request, settings),
+            request.weather,
+        )  # fmt: skip
     except CoreError as error:
         if error.field == "start":  # the trips would run past the year 9999
             raise error.at("date") from None
@@ -122,9 +126,7 @@ def run_scenarios(request: ScenariosRequest, settings: Settings) -> ScenariosRes
     try:
         grid = scenario_grid(
             plan_problem(request.plan, settings),
-            seasons,
-            request.driver_aggressiveness,
-            request.traffic_density,
+            GridAxes(seasons, request.driver_aggressiveness, request.traffic_density),
             router=connectors.router(settings),
             weather_service=connectors.weather_service(settings),
             max_simulated_s=settings.max_sync_simulated_s,

@@ -49,6 +49,7 @@ from core.physics.simulate import (
     MAX_ABS_GRADE,
     MAX_PAYLOAD_KG,
     MAX_SPEED_MPS,
+    Along,
     SimulationResult,
     simulate,
 )
@@ -476,10 +477,10 @@ def _simulated(van: VanParams, trip: _Resampled) -> SimulationResult:
         trip.trip.start,
         trip.trip.location,
         van,
-        grade=trip.grade,
-        payload_kg=trip.payload_kg,
         weather=_weather(trip),
-        door_openings=trip.trip.door_openings,
+        along=Along(
+            grade=trip.grade, payload_kg=trip.payload_kg, door_openings=trip.trip.door_openings
+        ),
     )
 
 

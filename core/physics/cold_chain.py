@@ -86,14 +86,10 @@ class TwoNodes:
 
 def two_nodes(
     box: CargoBoxParams,
-    air_capacity_j_k: float,
-    conductance_w_k: FloatArray,
-    equilibrium_c: FloatArray,
-    ambient_c: FloatArray,
+    flows: tuple[FloatArray, FloatArray, FloatArray],
     payload_kg: FloatArray,
-    setpoint_c: FloatArray | tuple[FloatArray, FloatArray],
+    setpoints: Setpoints,
     dt_s: float,
-    start_c: tuple[float, float],
 ) -> TwoNodes:
     """The air and the goods over steps of ``dt_s`` (blocks of :data:`BOX_STEP_S`).
 
@@ -101,29 +97,29 @@ def two_nodes(
     ----------
     box
         The box, its unit (cooling and heating capacities; the paper's steady mode: unlimited)
-        and its goods (specific heat, conductance per kg).
-    air_capacity_j_k
-        ``C_a`` [J/K].
-    conductance_w_k, equilibrium_c, ambient_c
+        and its goods (specific heat, conductance per kg); the air's heat capacity ``C_a``
+        [J/K] from it (:func:`air_heat_capacity_j_k`).
+    flows
         ``G`` [W/K], ``ϑ_eq`` and the outside air (the unit's capacity) [°C] of each step.
     payload_kg
         The goods aboard in each step [kg].
-    setpoint_c
-        The air set-point of each step [°C]: the unit cools above it and heats below it; or
-        two, the unit cooling above the first and heating below the second.
-    start_c
-        The air's and the goods' temperatures at the start [°C].
+    setpoints
+        The air of each step the unit cools down to and heats up to [°C], and the air's and
+        the goods' temperatures at the start [°C] (``departure_c``).
+    dt_s
+        The step [s].
     """
+    conductance_w_k, equilibrium_c, ambient_c = flows
+    start_c = setpoints.departure_c
     n = conductance_w_k.size
     blocks = Blocks(n, round(BOX_STEP_S / dt_s))
     edges, counts, mean = blocks.edges, blocks.counts, blocks.mean
     mass = mean(payload_kg)
-    cool_to, heat_to = setpoint_c if isinstance(setpoint_c, tuple) else (setpoint_c, setpoint_c)
     air, product, removed, added, paid = _on_blocks(
         box,
-        (air_capacity_j_k, mass),
+        (air_heat_capacity_j_k(box), mass),
         (mean(conductance_w_k), mean(equilibrium_c), mean(ambient_c)),
-        (mean(cool_to), mean(heat_to)),
+        (mean(setpoints.cool_to_c), mean(setpoints.heat_to_c)),
         counts * dt_s,
         start_c,
     )
@@ -624,17 +620,7 @@ def follow(
     """The box with its unit following ``setpoints`` from their departure temperatures (the
     arguments as :func:`box_with_goods`')."""
     door_w_k, conductance, equilibrium = _flows(box, outside)
-    nodes = two_nodes(
-        box,
-        air_heat_capacity_j_k(box),
-        conductance,
-        equilibrium,
-        outside[0],
-        payload_kg,
-        (setpoints.cool_to_c, setpoints.heat_to_c),
-        dt_s,
-        setpoints.departure_c,
-    )
+    nodes = two_nodes(box, (conductance, equilibrium, outside[0]), payload_kg, setpoints, dt_s)
     return _result(box, outside[0], outside[1], door_w_k, nodes, dt_s)
 
 

@@ -230,47 +230,16 @@ def sun(utc_s: FloatArray, location: Location) -> tuple[FloatArray, FloatArray]:
     return sin_altitude(location.lat, declination_deg(day_of_year)[day], solar_hour), month
 
 
-def simulate(
-    speed_mps: ArrayLike,
-    dt_s: float,
-    start: dt.datetime,
-    location: Location,
-    van: VanParams,
-    *,
-    grade: ArrayLike = 0.0,
-    payload_kg: ArrayLike | None = None,
-    weather: Forecast | None = None,
-    door_openings: Sequence[DoorOpening] = (),
-    parked: Sequence[Interval] = (),
-    heading_deg: ArrayLike | None = None,
-    charging: Sequence[ChargingSpell] = (),
-    box_start_c: float | None = None,
-    product_start_c: float | None = None,
-    air_setpoints: Sequence[SetpointSpan] = (),
-) -> SimulationResult:
-    """Simulate every consumer of the van along one speed trace (paper Fig. 7, one leg).
+@dataclass(frozen=True)
+class Along:
+    """What the van does along its speed trace besides driving it, and its box's start.
 
     Parameters
     ----------
-    speed_mps
-        Speed samples [m/s] every ``dt_s``.
-    dt_s
-        Sampling interval [s].
-    start
-        Timezone-aware time of the first sample; sets the sun, the ambient temperature and the
-        cabin load through the day. Time advances in true seconds (UTC), so a trace across a
-        daylight-saving change keeps its sun and temperature.
-    location
-        Where the van drives (latitude for the sun and the climatology; longitude for solar
-        time).
-    van
-        Vehicle, cargo box, battery and departure payload.
     grade
         Road grade [–], a number or one value per sample (eq. 5).
     payload_kg
         Payload [kg], a number or one value per sample; ``None`` takes ``van.payload_kg``.
-    weather
-        An hourly forecast, the day's extremes, or ``None`` for the climatology of each day.
     door_openings
         When the cargo door is open, in seconds after the start.
     parked
@@ -293,25 +262,63 @@ def simulate(
         With a product in the box: a schedule for the unit to follow instead of its strategy
         (a plan's, replayed against the day as it went), seconds after the start, in order
         and not overlapping; outside its spans the unit holds ``cargo_box.setpoint_c``.
+    """
+
+    grade: ArrayLike = 0.0
+    payload_kg: ArrayLike | None = None
+    door_openings: Sequence[DoorOpening] = ()
+    parked: Sequence[Interval] = ()
+    heading_deg: ArrayLike | None = None
+    charging: Sequence[ChargingSpell] = ()
+    box_start_c: float | None = None
+    product_start_c: float | None = None
+    air_setpoints: Sequence[SetpointSpan] = ()
+
+
+def simulate(
+    speed_mps: ArrayLike,
+    dt_s: float,
+    start: dt.datetime,
+    location: Location,
+    van: VanParams,
+    weather: Forecast | None = None,
+    along: Along = Along(),
+) -> SimulationResult:
+    """Simulate every consumer of the van along one speed trace (paper Fig. 7, one leg).
+
+    Parameters
+    ----------
+    speed_mps
+        Speed samples [m/s] every ``dt_s``.
+    dt_s
+        Sampling interval [s].
+    start
+        Timezone-aware time of the first sample; sets the sun, the ambient temperature and the
+        cabin load through the day. Time advances in true seconds (UTC), so a trace across a
+        daylight-saving change keeps its sun and temperature.
+    location
+        Where the van drives (latitude for the sun and the climatology; longitude for solar
+        time).
+    van
+        Vehicle, cargo box, battery and departure payload.
+    weather
+        An hourly forecast, the day's extremes, or ``None`` for the climatology of each day.
+    along
+        The grade, payload, doors, stands, heading and charges along the trace, and the box's
+        start.
 
     Returns
     -------
     SimulationResult
     """
-    trace = _driven(
-        van,
-        speed_mps,
-        dt_s,
-        grade,
-        payload_kg,
-        (door_openings, parked, charging, air_setpoints),
-        heading_deg,
-    )
+    trace = _driven(van, speed_mps, dt_s, along)
     n = trace.speed.size
     check_representable(start, (n - 1) * dt_s)
     outside = _environment(start, location, van, weather, n - 1, dt_s)
-    power, box, cab_gap_j = _consumers(van, trace, dt_s, outside, (box_start_c, product_start_c))
-    departs_depot = van.precondition_at_depot and box_start_c is None
+    power, box, cab_gap_j = _consumers(
+        van, trace, dt_s, outside, (along.box_start_c, along.product_start_c)
+    )
+    departs_depot = van.precondition_at_depot and along.box_start_c is None
     grid_j = cab_gap_j + precondition_energy_j(van.cargo_box, outside.start_c) + box.precool_grid_j
     return _result(
         trace,
@@ -376,27 +383,18 @@ class _Trace:
     air_setpoints: Sequence[SetpointSpan] = ()
 
 
-def _driven(
-    van: VanParams,
-    speed_mps: ArrayLike,
-    dt_s: float,
-    grade: ArrayLike,
-    payload_kg: ArrayLike | None,
-    spans: tuple[
-        Sequence[DoorOpening], Sequence[Interval], Sequence[ChargingSpell], Sequence[SetpointSpan]
-    ],
-    heading_deg: ArrayLike | None,
-) -> _Trace:
+def _driven(van: VanParams, speed_mps: ArrayLike, dt_s: float, along: Along) -> _Trace:
     """The inputs checked, and the trace the van drives: the one asked for, or — when it asks
     for more than the motor's cap — the slower one the van can drive
     (:func:`core.physics.motor.power_limited`), with every per-sample input and every interval
     moved to the moment the van reaches its place."""
     speed = check_trace(speed_mps, dt_s, min_samples=1)
     n = speed.size
-    payload = van.payload_kg if payload_kg is None else payload_kg
-    grade_step = _per_step(grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
+    payload = van.payload_kg if along.payload_kg is None else along.payload_kg
+    grade_step = _per_step(along.grade, n, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE)
     payload_step = _per_step(payload, n, "payload_kg", 0.0, MAX_PAYLOAD_KG)
-    door_openings, parked, charging, air_setpoints = spans
+    door_openings, parked, charging = along.door_openings, along.parked, along.charging
+    air_setpoints, heading_deg = along.air_setpoints, along.heading_deg
     _check_within(
         (n - 1) * dt_s,
         door_openings=door_openings,
@@ -437,7 +435,7 @@ def _driven(
     cap_kw = (van.vehicle.max_motor_power_w or 0.0) / 1000
     return _Trace(
         retimed.speed_mps,
-        _per_step(linear(grade), m, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE),
+        _per_step(linear(along.grade), m, "grade", -MAX_ABS_GRADE, MAX_ABS_GRADE),
         _per_step(stepwise(payload), m, "payload_kg", 0.0, MAX_PAYLOAD_KG),
         None if heading_deg is None else stepwise(heading_deg),
         [moved(d) for d in door_openings],

@@ -70,32 +70,39 @@ def sweep_street(speed_kmh: float) -> StreetType:
     )
 
 
+@dataclass(frozen=True)
+class SweepTrips:
+    """The trips of a speed sweep: each starts and ends at rest and covers ``distance_m``
+    [m], at least :data:`MIN_SWEEP_DISTANCE_M`. A passive driver (``driver_aggressiveness`` 0,
+    the paper's Fig. 10/11 setting) holds the speed; otherwise the speed swings in the highway
+    street type's trapezoid waves around it (paper §2.2), denser with more traffic
+    (``traffic_density`` ε_t; None: the street type's)."""
+
+    distance_m: float
+    driver_aggressiveness: float = 0.0
+    traffic_density: float | None = None
+
+
 def speed_sweep(
     speeds_kmh: Sequence[float],
-    distance_m: float,
+    trips: SweepTrips,
     start: dt.datetime,
     location: Location,
     van: VanParams,
     weather: Weather | None = None,
-    driver_aggressiveness: float = 0.0,
-    traffic_density: float | None = None,
 ) -> SpeedSweep:
     """Energy per km of flat trips at each mean speed (paper Fig. 11).
-
-    Each trip starts and ends at rest and covers ``distance_m``. A passive driver
-    (``driver_aggressiveness`` 0, the paper's Fig. 10/11 setting) holds the speed; otherwise the
-    speed swings in the highway street type's trapezoid waves around it (paper §2.2), denser with
-    more traffic.
 
     Parameters
     ----------
     speeds_kmh
         Mean speeds [km/h], each 1–200.
-    distance_m
-        Trip length [m], at least 100 m.
+    trips
+        Their length, driver and traffic.
     start, location, van, weather
         As for :func:`core.physics.simulate.simulate`.
     """
+    distance_m = trips.distance_m
     if not speeds_kmh:
         raise InvalidParameterError("speeds_kmh must hold at least one speed", "speeds_kmh")
     if not distance_m >= MIN_SWEEP_DISTANCE_M:
@@ -113,9 +120,9 @@ def speed_sweep(
         trace = generate_leg(
             distance_m,
             sweep_street(speed_kmh),
-            driver_aggressiveness,
+            trips.driver_aggressiveness,
             van.vehicle.max_acceleration_mps2,
-            traffic_density,
+            trips.traffic_density,
         )
         result = simulate(trace, 1.0, start, location, van, weather=weather)
         per_km = {k: v * 1e6 / result.distance_m for k, v in result.energy_kwh.items()}
@@ -168,11 +175,20 @@ DEFAULT_DRIVERS = (CALM_DRIVER, NORMAL_DRIVER, AGGRESSIVE_DRIVER)
 DEFAULT_TRAFFIC = (0.2, 0.8)
 
 
+@dataclass(frozen=True)
+class GridAxes:
+    """The axes of a scenario grid; None takes winter and summer of the round's year
+    (:func:`default_seasons`), calm/normal/aggressive drivers (ε_d 0.3, 0.5, 1.0) and
+    light/heavy traffic (ε_t 0.2, 0.8)."""
+
+    seasons: Sequence[Season] | None = None
+    drivers: Sequence[float] | None = None
+    traffic: Sequence[float | None] | None = None
+
+
 def scenario_grid(
     problem: PlanProblem,
-    seasons: Sequence[Season] | None = None,
-    drivers: Sequence[float] | None = None,
-    traffic: Sequence[float | None] | None = None,
+    axes: GridAxes = GridAxes(),
     progress: Callable[[int, int], None] | None = None,
     router: RoadRouter | None = None,
     weather_service: WeatherService | None = None,
@@ -189,9 +205,8 @@ def scenario_grid(
     ----------
     problem
         The round and its baseline conditions.
-    seasons, drivers, traffic
-        The axes; None takes winter/summer, calm/normal/aggressive (ε_d 0.3, 0.5, 1.0) and
-        light/heavy traffic (ε_t 0.2, 0.8).
+    axes
+        The seasons, drivers and traffic.
     progress
         Called with (cells done, cells in all) after each cell.
     router, weather_service
@@ -202,9 +217,9 @@ def scenario_grid(
         Most time the cells may simulate together [s] (the baseline round's duration times
         the cells); beyond, :class:`core.exceptions.TooMuchToWaitForError`. None: no bound.
     """
-    seasons = list(seasons) if seasons is not None else default_seasons(problem.date.year)
-    drivers = list(drivers) if drivers is not None else list(DEFAULT_DRIVERS)
-    traffic = list(traffic) if traffic is not None else list(DEFAULT_TRAFFIC)
+    seasons = list(axes.seasons) if axes.seasons is not None else default_seasons(problem.date.year)
+    drivers = list(axes.drivers) if axes.drivers is not None else list(DEFAULT_DRIVERS)
+    traffic = list(axes.traffic) if axes.traffic is not None else list(DEFAULT_TRAFFIC)
     for name, axis in (
         ("seasons", seasons),
         ("driver_aggressiveness", drivers),

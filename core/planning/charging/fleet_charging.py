@@ -44,11 +44,10 @@ from core.params import BatteryParams, ChargePoint, Charger
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, charge_curve
 from core.planning.day.estimates import cost_matrix, energy_matrix_j
-from core.planning.day.recharge import Busy
 from core.planning.day.scene import charge_points
 from core.planning.day.start_state import start_payload_kg
 from core.planning.day.timeline import EU_BREAK_S, MAX_DRIVING_S, seconds_after
-from core.planning.day.verify import Failure, route_failure
+from core.planning.day.verify import Busy, Failure, route_failure
 from core.planning.itinerary import ChargeVisit, Itinerary
 from core.planning.model import DEPOT_CHARGER_ID, PlanProblem, PlanResult
 from core.planning.search.day import FleetDay, long_where_no_road

@@ -19,7 +19,7 @@ from core.params import STREET_TYPES, Interval, Location, Stop
 from core.physics.battery import JOULES_PER_KWH, capacity_factor, energy_factor
 from core.physics.cargo import door_heat_w, refrigeration_cop
 from core.physics.cycles import generate_leg
-from core.physics.simulate import CONSUMERS, SimulationResult, simulate
+from core.physics.simulate import CONSUMERS, Along, SimulationResult, simulate
 from core.physics.vehicle import step_traction_power_w
 from core.planning.day.timeline import PLAN_DT_S
 from core.planning.model import PlanProblem
@@ -43,7 +43,7 @@ def standing(problem: PlanProblem, start: dt.datetime, parked: bool = False) -> 
         Location(lat=problem.depot.lat, lon=problem.depot.lon),
         problem.van.model_copy(update={"precondition_at_depot": True}),
         weather=problem.weather,
-        parked=[Interval(start_s=0.0, duration_s=2 * PLAN_DT_S)] if parked else [],
+        along=Along(parked=[Interval(start_s=0.0, duration_s=2 * PLAN_DT_S)] if parked else []),
     )
 
 

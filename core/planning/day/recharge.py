@@ -28,22 +28,20 @@ that holds on the objective is kept. The verdict is always the final simulation'
 
 from __future__ import annotations
 
-import datetime as dt
 import itertools
 import math
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 from core.params import ChargePoint, Charger
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.charging import WATTS_PER_KW, ChargeCurve, charge_curve
-from core.planning.day.scene import Scene, charge_points
+from core.planning.day.scene import charge_points
 from core.planning.day.timeline import next_window, seconds_after
-from core.planning.day.verify import simulate_route
+from core.planning.day.verify import Drive, simulate_route
 from core.planning.itinerary import ChargeVisit, Itinerary, Windows
-from core.planning.model import PlanProblem, PlanResult, Solved
-from core.routing.roads import LegRoute
+from core.planning.model import PlanProblem, PlanResult
 
 #: State of charge charged beyond what the next stretch needs and its reserve [–]: the
 #: stretch is simulated again after the charge and may start a little later, in other weather.
@@ -56,10 +54,6 @@ RETURN_ENERGY_FACTOR = 1.25
 OPTIONS_TRIED = 3
 #: Longest charge planned [s] (a day): a slower charge is no option, and the answer says so.
 MAX_CHARGE_S = 86_400.0
-
-Roads = Callable[[list[int]], list[LegRoute] | None]
-#: When every point of a charger is taken by other vans, by the charger's place index.
-Busy = Mapping[int, Sequence[tuple[dt.datetime, dt.datetime]]]
 
 
 class Orders(Protocol):
@@ -75,40 +69,28 @@ class Orders(Protocol):
         ...
 
 
-def with_charges(
-    problem: PlanProblem,
-    scene: Scene,
-    itinerary: Itinerary,
-    start: dt.datetime,
-    roads: Roads,
-    solved: Solved,
-    windows_s: Sequence[Windows] | None = None,
-    orders: Orders | None = None,
-    latest_return_s: float | None = None,
-    busy: Busy | None = None,
-) -> PlanResult:
-    """The ``itinerary`` simulated, with charges between stops where the battery would
-    not last (none when it does, or without chargers). With ``orders``, the round is then
-    solved again through the chargers it visits, and each stretch between charges put in its
-    own best order: the best of these that holds is kept (:func:`_better_orders`).
+def with_charges(day: Drive, itinerary: Itinerary, orders: Orders | None = None) -> PlanResult:
+    """The ``itinerary`` driven as ``day`` says and simulated, with charges between stops
+    where the battery would not last (none when it does, or without chargers). With
+    ``orders``, the round is then solved again through the chargers it visits, and each
+    stretch between charges put in its own best order: the best of these that holds is kept
+    (:func:`_better_orders`).
 
-    With ``windows_s`` (each place's time windows [s after ``start``]) and
-    ``latest_return_s`` (when the van must be back), a charge is only made where the time it
-    adds leaves every later window and the return in time (the forward time slack); ``busy``
+    With the day's windows and latest return, a charge is only made where the time it adds
+    leaves every later window and the return in time (the forward time slack); its ``busy``
     says when other vans take every point of a charger: the van charges between. The
     itinerary's charges are visits to start from, fitted again: a plan that changed a little
     keeps its charges where they still serve (:attr:`PlanResult.itinerary`)."""
-    day = _Round(problem, scene, start, roads, solved, windows_s, latest_return_s, busy or {})
-    points = charge_points(problem, scene.places)
+    points = charge_points(day.problem, day.scene.places)
     if itinerary.charges:  # the visits of an earlier plan, fitted again (open when free now)
         order = itinerary.order
         first = {
-            q: replace(c, open_s=day.open_s(order[q], points[order[q]]))
+            q: replace(c, open_s=_open_s(day, order[q], points[order[q]]))
             for q, c in itinerary.charges.items()
         }
         charged = _refitted(day, Itinerary(order, first))
     else:
-        charged = _Charged(itinerary, day.simulate(itinerary))
+        charged = _Charged(itinerary, simulate_route(day, itinerary))
     if not points or charged.result.battery.feasible:
         return charged.result
     charged = _charged_until_it_holds(day, points, charged)
@@ -129,7 +111,7 @@ def with_charges(
     return result
 
 
-def _too_slow(day: _Round, points: dict[int, ChargePoint]) -> list[str]:
+def _too_slow(day: Drive, points: dict[int, ChargePoint]) -> list[str]:
     """A warning for each charger at which the van would charge from its reserve to full in
     more than :data:`MAX_CHARGE_S` (its charging curve, or the charger, too slow)."""
     reserve = day.problem.van.battery.min_soc
@@ -149,7 +131,7 @@ def _too_slow(day: _Round, points: dict[int, ChargePoint]) -> list[str]:
 
 
 def _charged(
-    day: _Round, points: dict[int, ChargePoint], charged: _Charged, stretch: tuple[int, int]
+    day: Drive, points: dict[int, ChargePoint], charged: _Charged, stretch: tuple[int, int]
 ) -> _Charged | None:
     """The day with one more charge in ``stretch``: the best of the options
     (:func:`_charge_options`, at most :data:`OPTIONS_TRIED` simulated) that the simulation
@@ -181,7 +163,7 @@ class _Charged:
 
 
 def _charged_until_it_holds(
-    day: _Round, points: dict[int, ChargePoint], charged: _Charged
+    day: Drive, points: dict[int, ChargePoint], charged: _Charged
 ) -> _Charged:
     """``charged`` with one more charge in its first stretch below the reserve, again and
     again, until the battery holds or no charger is within reach."""
@@ -196,53 +178,29 @@ def _charged_until_it_holds(
     return charged
 
 
-@dataclass(frozen=True)
-class _Round:
-    """What every simulation of the round shares; :meth:`simulate` drives one order."""
+def _curve(day: Drive, point: ChargePoint, result: PlanResult) -> ChargeCurve:
+    """The van's charging curve at ``point`` (on the battery's usable capacity as aged)."""
+    battery = day.problem.van.battery
+    share = result.battery.usable_capacity_kwh / battery.usable_capacity_kwh
+    return charge_curve(battery, point.power_kw * WATTS_PER_KW, share)
 
-    problem: PlanProblem
-    scene: Scene
-    start: dt.datetime
-    roads: Roads
-    solved: Solved
-    windows_s: Sequence[Windows] | None
-    latest_return_s: float | None = None
-    busy: Busy = field(default_factory=dict)
 
-    def simulate(self, itinerary: Itinerary) -> PlanResult:
-        return simulate_route(
-            self.problem,
-            self.scene,
-            itinerary,
-            self.start,
-            self.roads(list(itinerary.order)),
-            self.solved,
-            self.windows_s,
-            self.latest_return_s,
-        )
-
-    def curve(self, point: ChargePoint, result: PlanResult) -> ChargeCurve:
-        """The van's charging curve at ``point`` (on the battery's usable capacity as aged)."""
-        battery = self.problem.van.battery
-        share = result.battery.usable_capacity_kwh / battery.usable_capacity_kwh
-        return charge_curve(battery, point.power_kw * WATTS_PER_KW, share)
-
-    def open_s(self, place: int, point: ChargePoint) -> Windows:
-        """When ``point`` (at ``place``) is open and has a point free [s after the
-        departure]; empty: always."""
-        date, start = self.problem.date, self.start
-        hours = [
-            (seconds_after(date, w.start, start), seconds_after(date, w.end, start))
-            for w in (point.opening_hours if isinstance(point, Charger) else ())
-        ]
-        taken = [
-            ((a - start).total_seconds(), (b - start).total_seconds())
-            for a, b in self.busy.get(place, ())
-        ]
-        if not taken:
-            return hours
-        free = _without(hours or [(-math.inf, math.inf)], sorted(taken))
-        return free or [(-math.inf, -math.inf)]  # taken all day: never free
+def _open_s(day: Drive, place: int, point: ChargePoint) -> Windows:
+    """When ``point`` (at ``place``) is open and has a point free [s after the
+    departure]; empty: always."""
+    date, start = day.problem.date, day.start
+    hours = [
+        (seconds_after(date, w.start, start), seconds_after(date, w.end, start))
+        for w in (point.opening_hours if isinstance(point, Charger) else ())
+    ]
+    taken = [
+        ((a - start).total_seconds(), (b - start).total_seconds())
+        for a, b in day.busy.get(place, ())
+    ]
+    if not taken:
+        return hours
+    free = _without(hours or [(-math.inf, math.inf)], sorted(taken))
+    return free or [(-math.inf, -math.inf)]  # taken all day: never free
 
 
 def _without(windows: Windows, taken: Windows) -> list[tuple[float, float]]:
@@ -262,7 +220,7 @@ def _without(windows: Windows, taken: Windows) -> list[tuple[float, float]]:
 
 
 def _better_orders(
-    day: _Round, points: dict[int, ChargePoint], charged: _Charged, orders: Orders
+    day: Drive, points: dict[int, ChargePoint], charged: _Charged, orders: Orders
 ) -> PlanResult:
     """The best on the objective of the charged round and of others, each with its charges
     fitted again and kept only when its battery holds: the whole round solved again through
@@ -298,15 +256,15 @@ def _better_orders(
     return best
 
 
-def _refitted(day: _Round, itinerary: Itinerary) -> _Charged:
+def _refitted(day: Drive, itinerary: Itinerary) -> _Charged:
     """The day of ``itinerary`` with its charges fitted to what it takes. A visit left with
     nothing to charge is dropped, and the others fitted again: its detour is no longer driven,
     so the stretch it closed takes less."""
-    result = day.simulate(itinerary)
+    result = simulate_route(day, itinerary)
     for _ in range(len(itinerary.charges) + 1):
         fitted = _fitted(day.problem, itinerary, result)
         itinerary = itinerary.refitted(fitted)
-        result = day.simulate(itinerary)
+        result = simulate_route(day, itinerary)
         if len(itinerary.charges) == len(fitted):
             break
     return _Charged(itinerary, result)
@@ -350,7 +308,7 @@ class _Option:
 
 
 def _charge_options(
-    day: _Round, points: dict[int, ChargePoint], charged: _Charged, stretch: tuple[int, int]
+    day: Drive, points: dict[int, ChargePoint], charged: _Charged, stretch: tuple[int, int]
 ) -> list[_Option]:
     """Where the van may charge within ``stretch``, best first: after each stop it leaves
     with its reserve, each charger it reaches with its reserve and that is open long enough
@@ -388,7 +346,7 @@ def _charge_options(
             if place in (here, onward):
                 continue
             come_s = left_s + legs.duration_s[here, place]
-            open_s = day.open_s(place, point)
+            open_s = _open_s(day, place, point)
             hours = next_window(come_s, open_s)
             if hours is None:
                 continue
@@ -403,7 +361,7 @@ def _charge_options(
                 - legs.duration_s[here, onward]
             )
             needed = reserve + rest + way_soc(place, onward) + PARTIAL_CHARGE_MARGIN
-            curve = day.curve(point, result)
+            curve = _curve(day, point, result)
             charge_s = curve.time_s(plugged, min(needed, 1.0))
             if come_s + wait_s + plug_s + charge_s > hours[1] or charge_s > MAX_CHARGE_S:
                 continue  # it closes before the charge is done, or it charges too slowly
@@ -422,7 +380,7 @@ def _charge_options(
 
 
 def _reload_charge(
-    day: _Round, point: ChargePoint, p: int, result: PlanResult, rest_j: float
+    day: Drive, point: ChargePoint, p: int, result: PlanResult, rest_j: float
 ) -> _Option | None:
     """Charging at the depot's ``point`` while the van reloads at position ``p``: the time
     beyond the reload it adds (with any wait for a free point); None when the van comes back
@@ -430,13 +388,13 @@ def _reload_charge(
     arriving = result.legs[p - 1].soc_end
     reserve = day.problem.van.battery.min_soc
     come_s = (result.legs[p - 1].arrive - day.start).total_seconds()
-    open_s = day.open_s(0, point)
+    open_s = _open_s(day, 0, point)
     hours = next_window(come_s, open_s)
     if arriving < reserve or hours is None:
         return None
     capacity_j = result.battery.usable_capacity_kwh * JOULES_PER_KWH
     needed = min(reserve + rest_j / capacity_j + PARTIAL_CHARGE_MARGIN, 1.0)
-    curve = day.curve(point, result)
+    curve = _curve(day, point, result)
     plug_s = point.plug_minutes * 60
     wait_s = max(hours[0] - come_s, 0.0)
     charge_s = curve.time_s(arriving, needed)
@@ -449,7 +407,7 @@ def _reload_charge(
     return _Option(p, 0, added_s, visit, inserted=False)
 
 
-def _slack_s(day: _Round, order: Sequence[int], result: PlanResult) -> list[float]:
+def _slack_s(day: Drive, order: Sequence[int], result: PlanResult) -> list[float]:
     """How much later the van may reach each position of ``order`` and still serve every
     later stop inside its window and be back in time [s] (Savelsbergh's forward time slack,
     *ORSA J. Computing* 4 (1992) 146: a delay is absorbed by the waits, then shifts each

@@ -10,8 +10,8 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from core.clock import at, check_representable
 from core.params import Location, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.cycles import trace_distance_m
-from core.physics.simulate import CONSUMERS, SimulationResult, simulate
+from core.physics.simulate import CONSUMERS, Along, SimulationResult, simulate
 from core.planning.day.box import cold_chain, deliveries, refrigeration, temperatures
 from core.planning.day.scene import Scene, charge_points
 from core.planning.day.start_state import box_start_c, product_start_c, start_payload_kg
@@ -53,17 +53,15 @@ from core.routing.roads import LegRoute
 PROFILE_STEP_S = 60.0
 
 
-def simulate_route(
-    problem: PlanProblem,
-    scene: Scene,
-    itinerary: Itinerary,
-    start: dt.datetime,
-    roads: list[LegRoute] | None,
-    solved: Solved,
-    windows_s: Sequence[Windows] | None = None,
-    latest_return_s: float | None = None,
-) -> PlanResult:
-    """Drive the ``itinerary`` from ``start`` and simulate the day.
+#: The road of each leg of an order of places (place indices) from a router; None: traces.
+Roads = Callable[[list[int]], list[LegRoute] | None]
+#: When every point of a charger is taken by other vans, by the charger's place index.
+Busy = Mapping[int, Sequence[tuple[dt.datetime, dt.datetime]]]
+
+
+@dataclass(frozen=True)
+class Drive:
+    """One van's round as every simulation of it sees it.
 
     Parameters
     ----------
@@ -71,12 +69,11 @@ def simulate_route(
         The van, the stops and the conditions.
     scene
         The places, their legs, the zone and the weather.
-    itinerary
-        The places in driving order and the charges between them.
     start
         Departure (zone-aware).
     roads
-        The road of each leg of the itinerary from a router, or None to generate the traces.
+        The road of each leg of an order of places from a router, or None to generate the
+        traces.
     solved
         How the order was found (reported as it is).
     windows_s
@@ -86,7 +83,27 @@ def simulate_route(
         and listed in ``late_stops``.
     latest_return_s
         When the van must be back [s after ``start``], if ever.
+    busy
+        When other vans take every point of a charger (place index: spans), for the charges
+        placed on the round (:mod:`core.planning.day.recharge`).
     """
+
+    problem: PlanProblem
+    scene: Scene
+    start: dt.datetime
+    roads: Roads
+    solved: Solved
+    windows_s: Sequence[Windows] | None = None
+    latest_return_s: float | None = None
+    busy: Busy = field(default_factory=dict)
+
+
+def simulate_route(drive: Drive, itinerary: Itinerary) -> PlanResult:
+    """Drive the ``itinerary`` (the places in driving order and the charges between them) as
+    ``drive`` says, and simulate the day."""
+    problem, scene, start = drive.problem, drive.scene, drive.start
+    windows_s, latest_return_s = drive.windows_s, drive.latest_return_s
+    roads = drive.roads(list(itinerary.order))
 
     def laid_out(departure: dt.datetime, windows: Sequence[Windows] | None) -> Timeline:
         places, legs, rest = scene.places, scene.legs, rest_after(problem, departure)
@@ -110,18 +127,20 @@ def simulate_route(
         start,
         Location(lat=problem.depot.lat, lon=problem.depot.lon),
         problem.van,
-        grade=timeline.grade,
-        payload_kg=timeline.payload,
         weather=weather,
-        door_openings=timeline.doors,
-        parked=timeline.parked,
-        heading_deg=timeline.heading,
-        charging=timeline.charging,
-        box_start_c=box_start_c(problem),
-        product_start_c=product_start_c(problem),
+        along=Along(
+            grade=timeline.grade,
+            payload_kg=timeline.payload,
+            door_openings=timeline.doors,
+            parked=timeline.parked,
+            heading_deg=timeline.heading,
+            charging=timeline.charging,
+            box_start_c=box_start_c(problem),
+            product_start_c=product_start_c(problem),
+        ),
     )
     timeline = timeline.driven(result.sample_at)
-    return _Split(problem, scene, itinerary, result, timeline, start).result(solved, warnings)
+    return _Split(problem, scene, itinerary, result, timeline, start).result(drive.solved, warnings)
 
 
 def _long_day(problem: PlanProblem, start: dt.datetime, timeline: Timeline) -> list[str]:

@@ -37,6 +37,7 @@ from core.planning.day.scene import (
 )
 from core.planning.day.start_state import START_ID, check_start, path_tour, under_way
 from core.planning.day.timeline import client_legs_too_fast, windows_after
+from core.planning.day.verify import Drive
 from core.planning.fleet.planner import search
 from core.planning.itinerary import Itinerary
 from core.planning.model import (
@@ -122,20 +123,14 @@ def plan(
             return None
         return leg_roads(remembering, scene.places, driven)
 
-    result = with_charges(
-        problem,
-        scene,
-        Itinerary.of(order),
-        start,
-        roads,
-        Solved(
-            status=tour.status,
-            objective_value=tour.cost * unit_value + offset * (len(order) - 1),
-            runtime_s=tour.runtime_s,
-        ),
-        windows_after(problem.stops, problem.date, start) if windowed else None,
-        None if problem.keep_order else tours,
+    found = Solved(
+        status=tour.status,
+        objective_value=tour.cost * unit_value + offset * (len(order) - 1),
+        runtime_s=tour.runtime_s,
     )
+    windows = windows_after(problem.stops, problem.date, start) if windowed else None
+    drive = Drive(problem, scene, start, roads, found, windows)
+    result = with_charges(drive, Itinerary.of(order), None if problem.keep_order else tours)
     solved = _how_solved(tour, result, scene.places, tours.ends)
     warnings = [*result.warnings, *cut_short(solved.stopped_by)]
     return _replayable(effort, _in_time(problem, replace(result, solved=solved, warnings=warnings)))

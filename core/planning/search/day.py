@@ -20,11 +20,11 @@ from core.clock import at
 from core.exceptions import NoRouteError
 from core.params import Place
 from core.planning.day.estimates import VanEstimates, van_estimates
-from core.planning.day.recharge import Busy, with_charges
+from core.planning.day.recharge import with_charges
 from core.planning.day.scene import Scene
 from core.planning.day.start_state import start_payload_kg
 from core.planning.day.timeline import windows_after
-from core.planning.day.verify import simulate_route
+from core.planning.day.verify import Busy, Drive, simulate_route
 from core.planning.itinerary import Itinerary
 from core.planning.model import MAX_ROUND_S, PlanProblem, PlanResult, Solved, place_field
 from core.routing.geo import Legs
@@ -165,15 +165,8 @@ class FleetDay:
         return f"{at(self.reference, seconds):%H:%M}"
 
     def simulate(self, v: int, route: list[int]) -> PlanResult:
-        """The full simulation of van ``v`` driving ``route`` (stops; the depot around it):
-        windows from its own departure, the router's roads when the legs came from it, back by
-        its shift's end."""
-        problem, scene, order, start, solved = self._round(v, route)
-        windows, latest_s = self._limits(v)
-        itinerary = Itinerary.of(order)
-        return simulate_route(
-            problem, scene, itinerary, start, self._roads(order), solved, windows, latest_s
-        )
+        """The full simulation of van ``v`` driving ``route`` (stops; the depot around it)."""
+        return simulate_route(self._drive(v, route), Itinerary.of(self.order(v, route)))
 
     def charged(self, v: int, itinerary: Itinerary, busy: Busy) -> PlanResult:
         """Van ``v`` driving ``itinerary`` with its charges fitted again and more where its
@@ -181,20 +174,20 @@ class FleetDay:
         and its shift kept, the charge points free when ``busy`` says other vans do not take
         them all."""
         stops = [place for place in itinerary.order[1:-1] if place in self.stop_nodes]
-        problem, scene, _, start, solved = self._round(v, stops)
-        windows, latest_s = self._limits(v)
-        return with_charges(
-            problem, scene, itinerary, start, self._roads, solved, windows, None, latest_s, busy
-        )
+        return with_charges(self._drive(v, stops, busy), itinerary)
 
-    def _round(
-        self, v: int, route: list[int]
-    ) -> tuple[PlanProblem, Scene, list[int], dt.datetime, Solved]:
+    def _drive(self, v: int, route: list[int], busy: Busy | None = None) -> Drive:
+        """Van ``v``'s round of ``route`` as its simulations see it: windows from its own
+        departure, the router's roads when the legs came from it, back by its shift's end."""
         shift = self.shifts[v]
         solved = Solved(
             status="feasible", objective_value=self.estimates[v].route_cost(route), runtime_s=0.0
         )
-        return shift.problem, self.scene, self.order(v, route), shift.start, solved
+        windows, latest_s = self._limits(v)
+        return Drive(
+            shift.problem, self.scene, shift.start, self._roads, solved, windows, latest_s,
+            busy or {},
+        )  # fmt: skip
 
     def _roads(self, order: list[int]) -> list[LegRoute] | None:
         if self.router is None or self.scene.legs.source != "osrm":

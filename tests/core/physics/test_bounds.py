@@ -25,7 +25,7 @@ from core.params import (
     Weather,
 )
 from core.physics.cycles import generate_leg
-from core.physics.simulate import simulate
+from core.physics.simulate import Along, simulate
 
 START = dt.datetime(2026, 7, 15, 12, 0, tzinfo=ZoneInfo("Europe/Vienna"))
 HOT = Weather(t_min_c=25, t_max_c=38)
@@ -89,8 +89,10 @@ def test_each_end_of_each_range_gives_a_finite_answer(section, name, value, mode
             Location(lat=48.2, lon=16.4),
             van,
             weather=HOT,
-            door_openings=[DoorOpening(start_s=speed.size, duration_s=300)],
-            parked=[Interval(start_s=speed.size, duration_s=600)],
+            along=Along(
+                door_openings=[DoorOpening(start_s=speed.size, duration_s=300)],
+                parked=[Interval(start_s=speed.size, duration_s=600)],
+            ),
         )
     assert all(math.isfinite(v) for v in result.energy_kwh.values())
     assert np.all(np.isfinite(result.soc)) and np.all(np.isfinite(result.box.temperature_c))

@@ -139,7 +139,7 @@ def test_empty_box_with_an_open_door_stays_below_the_outside_air():
     # outside air and its sol-air excess. By hand (no sun at 03:00): G = UA + G_door,
     # ϑ_eq = 30 − 3000 W / G, exact response over the 300 s of open door.
     from core.params import DoorOpening, Location, VanParams, Weather
-    from core.physics.simulate import simulate
+    from core.physics.simulate import Along, simulate
 
     box = CargoBoxParams(mode="dynamic", **CONSTANT_UNIT)
     van = VanParams(cargo_box=box)
@@ -150,9 +150,8 @@ def test_empty_box_with_an_open_door_stays_below_the_outside_air():
         start,
         Location(lat=48.21, lon=16.37),
         van,
-        payload_kg=0.0,
         weather=Weather(t_min_c=30, t_max_c=30),
-        door_openings=[DoorOpening(start_s=100, duration_s=300)],
+        along=Along(payload_kg=0.0, door_openings=[DoorOpening(start_s=100, duration_s=300)]),
     )
     door_g = door_heat_w(box, 30.0, 4.0) / 26.0
     expected = _exact_c(30.0, 4.0, UA + door_g, heat_capacity_j_k(box, 0.0), 3000.0, 300.0)

@@ -13,7 +13,7 @@ import pytest
 from core.exceptions import InvalidParameterError
 from core.params import BatteryParams, ChargingSpell, Interval, Location, VanParams, Weather
 from core.physics.charging import charge_curve
-from core.physics.simulate import simulate, with_battery
+from core.physics.simulate import Along, simulate, with_battery
 
 KWH = 3.6e6
 VIENNA = Location(lat=48.21, lon=16.37)
@@ -101,12 +101,12 @@ def test_a_plugged_in_spell_charges_along_the_curve_while_the_consumers_run_from
     van = VanParams(battery=BatteryParams(usable_capacity_kwh=40.0, initial_soc=0.5))
     start = dt.datetime(2026, 7, 15, 12, 0, tzinfo=ZoneInfo("Europe/Vienna"))
     spell = ChargingSpell(start_s=600.0, duration_s=1800.0, power_kw=22.0)
-    standing = dict(
-        weather=Weather(t_min_c=20, t_max_c=31),
-        parked=[Interval(start_s=0.0, duration_s=3600.0)],
+    hot = Weather(t_min_c=20, t_max_c=31)
+    parked = [Interval(start_s=0.0, duration_s=3600.0)]
+    plugged = simulate(
+        np.zeros(3601), 1.0, start, VIENNA, van, hot, Along(parked=parked, charging=[spell])
     )
-    plugged = simulate(np.zeros(3601), 1.0, start, VIENNA, van, charging=[spell], **standing)
-    unplugged = simulate(np.zeros(3601), 1.0, start, VIENNA, van, **standing)
+    unplugged = simulate(np.zeros(3601), 1.0, start, VIENNA, van, hot, Along(parked=parked))
     load_j = sum(unplugged.power_w.values())  # the same consumers either way
     assert sum(plugged.power_w.values()) == pytest.approx(load_j)
     capacity_j = 40 * KWH
@@ -135,7 +135,7 @@ def test_a_long_spell_fills_the_battery_through_the_taper_and_no_further():
     van = VanParams(battery=BatteryParams(usable_capacity_kwh=40.0, initial_soc=0.7))
     start = dt.datetime(2026, 4, 15, 10, 0, tzinfo=ZoneInfo("Europe/Vienna"))
     spell = ChargingSpell(start_s=0.0, duration_s=7200.0, power_kw=150.0)
-    result = simulate(np.zeros(7201), 1.0, start, VIENNA, van, charging=[spell])
+    result = simulate(np.zeros(7201), 1.0, start, VIENNA, van, along=Along(charging=[spell]))
     curve = charge_curve(van.battery, 150e3)
     full_s = curve.time_s(0.7, 1.0)
     # 0.7 → 0.8 at 50 kW: 0.1·40 kWh/(0.9·50 kW) = 320 s; 0.8 → 1.0 tapering 50 → 10 kW

@@ -24,7 +24,7 @@ from core.params import (
 )
 from core.physics.cycles import generate_leg, trace_distance_m
 from core.physics.motor import CAP_TOLERANCE, mechanical_power_w, power_limited
-from core.physics.simulate import simulate
+from core.physics.simulate import Along, simulate
 
 VAN = VehicleParams()  # the paper's Table 1 van
 MASS = VAN.mass_kg + 550.0
@@ -112,9 +112,9 @@ def test_a_simulation_moves_what_comes_after_the_slow_drive():
     start = dt.datetime(2026, 7, 15, 9, tzinfo=ZoneInfo("Europe/Vienna"))
     door = DoorOpening(start_s=leg.size, duration_s=300)
     stop = Interval(start_s=leg.size, duration_s=600)
-    args = dict(weather=Weather(t_min_c=18, t_max_c=31), door_openings=[door], parked=[stop])
-    free = simulate(speed, 1.0, start, Location(lat=48.2, lon=16.4), VanParams(), **args)
-    slow = simulate(speed, 1.0, start, Location(lat=48.2, lon=16.4), van, **args)
+    warm, along = Weather(t_min_c=18, t_max_c=31), Along(door_openings=[door], parked=[stop])
+    free = simulate(speed, 1.0, start, Location(lat=48.2, lon=16.4), VanParams(), warm, along)
+    slow = simulate(speed, 1.0, start, Location(lat=48.2, lon=16.4), van, warm, along)
     assert slow.distance_m == pytest.approx(free.distance_m, rel=1e-9)
     assert slow.duration_s > free.duration_s + 60
     assert slow.warnings and "5 kW" in slow.warnings[0]

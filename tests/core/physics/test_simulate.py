@@ -20,7 +20,7 @@ from core.params import (
     Weather,
 )
 from core.physics.cycles import generate_leg, load_cycle_csv
-from core.physics.simulate import simulate
+from core.physics.simulate import Along, simulate
 
 VIENNA = Location(lat=48.21, lon=16.37)
 TZ = ZoneInfo("Europe/Vienna")
@@ -41,7 +41,7 @@ def test_reference_vehicle_matches_fastsim(reference_dir, name):
         SUMMER_NOON,
         VIENNA,
         PRESETS["reference-zoe"].van(),
-        grade=cycle.grade,
+        along=Along(grade=cycle.grade),
     )
     wh_per_km = result.energy_kwh["traction"] * 1e6 / result.distance_m
     assert wh_per_km == pytest.approx(FASTSIM_TRACTION_WH_KM[name], rel=0.05)
@@ -133,7 +133,7 @@ def test_door_opening_costs_its_heat_over_the_cop():
         VIENNA,
         VAN,
         weather=HOT_DAY,
-        door_openings=[DoorOpening(start_s=100, duration_s=600)],
+        along=Along(door_openings=[DoorOpening(start_s=100, duration_s=600)]),
     )
     door_kwh = opened.box.door_heat_w.sum() / 3.6e6
     assert 0.3 < door_kwh < 1.5
@@ -154,7 +154,9 @@ def test_the_sun_counts_by_day_and_not_at_night():
 def test_lighter_payload_uses_less_traction():
     trace = generate_leg(5_000, STREET_TYPES["urban"], 0.5, 2.0)
     full = simulate(trace, 1.0, SUMMER_NOON, VIENNA, VAN, weather=HOT_DAY)
-    empty = simulate(trace, 1.0, SUMMER_NOON, VIENNA, VAN, weather=HOT_DAY, payload_kg=0.0)
+    empty = simulate(
+        trace, 1.0, SUMMER_NOON, VIENNA, VAN, weather=HOT_DAY, along=Along(payload_kg=0.0)
+    )
     assert empty.energy_kwh["traction"] < full.energy_kwh["traction"]
 
 
@@ -198,13 +200,17 @@ def test_small_battery_is_infeasible():
     ],
 )
 def test_bad_inputs_name_the_field(speed, kwargs, field):
+    along_fields = ("grade", "payload_kg", "door_openings")
+    along = Along(**{k: v for k, v in kwargs.items() if k in along_fields})
+    rest = {k: v for k, v in kwargs.items() if k not in along_fields}
     args = {
         "speed_mps": speed,
         "dt_s": 1.0,
         "start": SUMMER_NOON,
         "location": VIENNA,
         "van": VAN,
-    } | kwargs
+        "along": along,
+    } | rest
     with pytest.raises(InvalidParameterError) as caught:
         simulate(**args)
     assert caught.value.field == field
@@ -230,10 +236,10 @@ def test_no_nan_for_any_valid_input(speed, grade, payload, hour, lat, lon, mode,
         start,
         Location(lat=lat, lon=lon),
         van,
-        grade=grade,
-        payload_kg=payload,
         weather=Weather(t_min_c=t_min, t_max_c=t_min + 10),
-        door_openings=[DoorOpening(start_s=0, duration_s=30)],
+        along=Along(
+            grade=grade, payload_kg=payload, door_openings=[DoorOpening(start_s=0, duration_s=30)]
+        ),
     )
     assert all(np.isfinite(v) for v in result.energy_kwh.values())
     assert np.all(np.isfinite(result.soc)) and np.all(np.isfinite(result.box.temperature_c))

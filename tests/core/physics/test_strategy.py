@@ -23,6 +23,7 @@ from core.params import (
 from core.physics.cargo import air_heat_capacity_j_k, refrigeration_cop
 from core.physics.cold_chain import (
     Run,
+    Setpoints,
     _constant,
     _flows,
     box_with_goods,
@@ -210,15 +211,10 @@ def on_off_day(hours: int, warmer_k: float, **changes):
     )
     n = hours * HOUR
     outside = (np.full(n, 30.0), np.zeros(n), np.zeros(n))
+    held = np.full(n, box.setpoint_c)
+    setpoints = Setpoints(held, held, (box.setpoint_c + warmer_k, box.load_c))
     nodes = two_nodes(
-        box,
-        air_heat_capacity_j_k(box),
-        *_flows(box, outside)[1:],
-        outside[0],
-        np.full(n, 500.0),
-        np.full(n, box.setpoint_c),
-        1.0,
-        (box.setpoint_c + warmer_k, box.load_c),
+        box, (*_flows(box, outside)[1:], outside[0]), np.full(n, 500.0), setpoints, 1.0
     )
     return box, nodes
 

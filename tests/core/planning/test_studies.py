@@ -19,7 +19,14 @@ from core.physics.cycles import generate_leg, trace_distance_m
 from core.physics.simulate import MAX_SPEED_MPS
 from core.planning.model import PlanProblem
 from core.planning.round.planner import plan
-from core.planning.studies import Season, scenario_grid, speed_sweep, sweep_street
+from core.planning.studies import (
+    GridAxes,
+    Season,
+    SweepTrips,
+    scenario_grid,
+    speed_sweep,
+    sweep_street,
+)
 
 NOON = dt.datetime(2026, 7, 15, 12, tzinfo=ZoneInfo("Europe/Vienna"))
 VIENNA = Location(lat=48.21, lon=16.37)
@@ -29,7 +36,7 @@ SPEEDS = [float(v) for v in range(20, 121, 10)]
 
 def test_best_constant_speed_on_a_hot_day_is_30_to_50():
     # Paper Fig. 11: about 40 km/h with the cooling unit.
-    sweep = speed_sweep(SPEEDS, 20_000, NOON, VIENNA, VanParams(), HOT)
+    sweep = speed_sweep(SPEEDS, SweepTrips(20_000), NOON, VIENNA, VanParams(), HOT)
     assert 30 <= sweep.optimum_speed_kmh <= 50
     totals = {p.speed_kmh: p.energy_wh_per_km["total"] for p in sweep.points}
     assert totals[sweep.optimum_speed_kmh] == min(totals.values())
@@ -44,11 +51,11 @@ def test_more_constant_load_moves_the_optimum_up():
     # Constant power P per km is P/v: a larger P makes the drag term's rise pay off later
     # (optimum v ∝ P^(1/3) on a flat road).
     fine = [float(v) for v in range(20, 101, 5)]
-    base = speed_sweep(fine, 20_000, NOON, VIENNA, VanParams(), HOT)
+    base = speed_sweep(fine, SweepTrips(20_000), NOON, VIENNA, VanParams(), HOT)
     heavier = VanParams(
         cargo_box=CargoBoxParams(cop=0.5), vehicle=VehicleParams(auxiliaries_power_w=2000)
     )
-    more = speed_sweep(fine, 20_000, NOON, VIENNA, heavier, HOT)
+    more = speed_sweep(fine, SweepTrips(20_000), NOON, VIENNA, heavier, HOT)
     assert more.optimum_speed_kmh > base.optimum_speed_kmh
 
 
@@ -68,19 +75,19 @@ def test_every_allowed_sweep_speed_swings_within_the_top_speed(speed_kmh):
 
 
 def test_a_sweep_at_the_top_speed_with_an_aggressive_driver_is_answered():
-    sweep = speed_sweep([50.0, 200.0], 20_000, NOON, VIENNA, VanParams(), HOT, 1.0)
+    sweep = speed_sweep([50.0, 200.0], SweepTrips(20_000, 1.0), NOON, VIENNA, VanParams(), HOT)
     fast, slow = sweep.points[1].energy_wh_per_km, sweep.points[0].energy_wh_per_km
     assert fast["traction"] > 3 * slow["traction"]  # drag ∝ v²: (200/50)² = 16 per km at the wheel
 
 
 def test_sweep_rejects_bad_speeds():
     with pytest.raises(InvalidParameterError) as caught:
-        speed_sweep([40, -5], 10_000, NOON, VIENNA, VanParams(), HOT)
+        speed_sweep([40, -5], SweepTrips(10_000), NOON, VIENNA, VanParams(), HOT)
     assert caught.value.field == "speeds_kmh[1]"
     with pytest.raises(InvalidParameterError):
-        speed_sweep([], 10_000, NOON, VIENNA, VanParams(), HOT)
+        speed_sweep([], SweepTrips(10_000), NOON, VIENNA, VanParams(), HOT)
     with pytest.raises(InvalidParameterError, match="at least 100 m"):
-        speed_sweep([40], 1e-300, NOON, VIENNA, VanParams(), HOT)
+        speed_sweep([40], SweepTrips(1e-300), NOON, VIENNA, VanParams(), HOT)
 
 
 def _round() -> PlanProblem:
@@ -109,7 +116,7 @@ def test_grid_cells_agree_with_single_plans():
     winter = Season(
         name="winter", date=dt.date(2026, 1, 15), weather=Weather(t_min_c=-8, t_max_c=0)
     )
-    grid = scenario_grid(problem, [winter], [0.2, 1.0], [0.3, 0.8])
+    grid = scenario_grid(problem, GridAxes([winter], [0.2, 1.0], [0.3, 0.8]))
     assert len(grid.cells) == 4
     by_id = {s.id: s for s in problem.stops}
     for cell in grid.cells:
@@ -138,7 +145,7 @@ def test_a_grid_of_a_round_that_reloads_keeps_its_trips():
     heavy = problem.model_copy(
         update={"van": problem.van.model_copy(update={"payload_kg": 200.0}), "max_trips": 2}
     )
-    grid = scenario_grid(heavy, None, [0.5], [0.3])
+    grid = scenario_grid(heavy, GridAxes(None, [0.5], [0.3]))
     assert grid.tour.count(heavy.depot.id) == 3
     assert len(grid.cells) == 2  # winter and summer
     for cell in grid.cells:
