@@ -38,7 +38,7 @@ from core.physics.cycles import (
     trace_distance_m,
 )
 from core.physics.motor import power_limited
-from core.physics.simulate import MAX_SPEED_MPS
+from core.physics.simulate import MAX_SPEED_MPS, Along
 from core.planning.day.start_state import start_payload_kg
 from core.planning.itinerary import ChargeVisit, Itinerary, Windows
 from core.planning.model import PlanProblem
@@ -275,6 +275,22 @@ class Timeline:
     def duration_s(self) -> float:
         """From departure to return [s]."""
         return (self.speed.size - 1) * PLAN_DT_S
+
+    def along(
+        self, box_start_c: float | None = None, product_start_c: float | None = None
+    ) -> Along:
+        """What the simulation drives along the day besides its speed (the box's start as
+        :class:`core.physics.simulate.Along` says)."""
+        return Along(
+            grade=self.grade,
+            payload_kg=self.payload,
+            door_openings=self.doors,
+            parked=self.parked,
+            heading_deg=self.heading,
+            charging=self.charging,
+            box_start_c=box_start_c,
+            product_start_c=product_start_c,
+        )
 
     def driven(self, sample_at: Callable[[ArrayLike], Any]) -> Timeline:
         """The marks moved to the samples of the trace the van drove (``sample_at``: a

@@ -19,7 +19,7 @@ from core.clock import at, check_representable
 from core.params import Location, Place
 from core.physics.battery import JOULES_PER_KWH
 from core.physics.cycles import trace_distance_m
-from core.physics.simulate import CONSUMERS, Along, SimulationResult, simulate
+from core.physics.simulate import CONSUMERS, SimulationResult, simulate
 from core.planning.day.box import cold_chain, deliveries, refrigeration, temperatures
 from core.planning.day.scene import Scene, charge_points
 from core.planning.day.start_state import box_start_c, product_start_c, start_payload_kg
@@ -127,17 +127,8 @@ def simulate_route(drive: Drive, itinerary: Itinerary) -> PlanResult:
         start,
         Location(lat=problem.depot.lat, lon=problem.depot.lon),
         problem.van,
-        weather=weather,
-        along=Along(
-            grade=timeline.grade,
-            payload_kg=timeline.payload,
-            door_openings=timeline.doors,
-            parked=timeline.parked,
-            heading_deg=timeline.heading,
-            charging=timeline.charging,
-            box_start_c=box_start_c(problem),
-            product_start_c=product_start_c(problem),
-        ),
+        weather,
+        timeline.along(box_start_c(problem), product_start_c(problem)),
     )
     timeline = timeline.driven(result.sample_at)
     return _Split(problem, scene, itinerary, result, timeline, start).result(drive.solved, warnings)

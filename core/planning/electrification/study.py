@@ -27,7 +27,7 @@ from core.exceptions import CoreError, InvalidParameterError, ServiceUnavailable
 from core.params import Location, Stop, VanParams, plain_rule, product_band
 from core.physics.battery import BatteryVerdict
 from core.physics.cold_chain import box_check
-from core.physics.simulate import CONSUMERS, Along, SimulationResult, simulate, with_battery
+from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
 from core.physics.weather import HourlyWeather, WeatherService
 from core.planning.day.scene import legs_for, round_places
 from core.planning.day.timeline import PLAN_DT_S, Timeline, build_timeline, rest_after
@@ -396,14 +396,8 @@ def route_year(
                 start,
                 location,
                 first.van,
-                weather=hours,
-                along=Along(
-                    grade=timeline.grade,
-                    payload_kg=timeline.payload,
-                    door_openings=timeline.doors,
-                    parked=timeline.parked,
-                    heading_deg=timeline.heading,
-                ),
+                hours,
+                timeline.along(),
             )
             for candidate_id in ids:
                 battery = vans[candidate_id].battery
