@@ -1,4 +1,4 @@
-"""Several trips: the summer day's 40 stops (tests/core/planning/test_recharge.py) at 20 kg
+"""Several trips: the summer day's 40 stops (tests/core/planning/day/test_recharge.py) at 20 kg
 each take 800 kg on a 400 kg van — two trips with a reload at the depot between — and the
 payloads, the reload's minutes and what a client may get wrong, by hand."""
 
@@ -14,7 +14,7 @@ from core.params import ChargePoint, TimeWindow
 from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, default_work_s, fields_of
 from core.planning.round.planner import plan
-from tests.core.planning.test_recharge import summer_day
+from tests.core.planning.day.test_recharge import summer_day
 
 
 def heavy(**fields):

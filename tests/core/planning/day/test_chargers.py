@@ -16,7 +16,7 @@ from core.params import Charger, RoadMatrix
 from core.planning.day.recharge import PARTIAL_CHARGE_MARGIN
 from core.planning.model import PlanProblem, PlanResult, StartState
 from core.planning.round.planner import plan
-from tests.core.planning.test_recharge import stretch_lows, summer_day
+from tests.core.planning.day.test_recharge import stretch_lows, summer_day
 
 KWH = 3.6e6
 #: A 150 kW charger 2.3 km east of the depot (Prater), and an 11 kW one beside the depot.

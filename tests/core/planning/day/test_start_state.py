@@ -15,7 +15,7 @@ from core.planning.day.start_state import START_ID
 from core.planning.fleet.planner import plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, StartState, fields_of
 from core.planning.round.planner import plan
-from tests.core.planning.test_recharge import summer_day
+from tests.core.planning.day.test_recharge import summer_day
 
 VIENNA = ZoneInfo("Europe/Vienna")
 

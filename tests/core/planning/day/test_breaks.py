@@ -11,7 +11,7 @@ from core.exceptions import InvalidParameterError
 from core.planning.day.timeline import EU_BREAK_S, MAX_DRIVING_S
 from core.planning.model import FixedBreak, FleetVehicle
 from core.planning.round.planner import plan
-from tests.core.planning.test_recharge import summer_day
+from tests.core.planning.day.test_recharge import summer_day
 
 HOUR = dt.timedelta(hours=1)
 

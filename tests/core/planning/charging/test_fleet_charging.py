@@ -1,4 +1,4 @@
-"""Charging in a fleet: the summer day's 40 stops (tests/core/planning/test_recharge.py) that
+"""Charging in a fleet: the summer day's 40 stops (tests/core/planning/day/test_recharge.py) that
 one 40 kWh van leaves half of for its battery are all served with a charger on the way, the
 EU break kept; vans that charge at one charge point never charge at once; the bookings say
 when a charger is full."""
@@ -32,8 +32,8 @@ from core.planning.fleet.planner import _failure, _given_to_idle, plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
 from core.planning.search.feasibility import Feasibility
 from core.routing.effort import Effort
-from tests.core.planning.test_breaks import driving_between_breaks_s
-from tests.core.planning.test_recharge import summer_day
+from tests.core.planning.day.test_breaks import driving_between_breaks_s
+from tests.core.planning.day.test_recharge import summer_day
 from tests.utils.fleets import DEPOT
 from tests.utils.fleets import day_of as cluster_day
 from tests.utils.fleets import fleet as cluster_fleet
