@@ -29,8 +29,8 @@ from tests.app.test_jobs import (
     wait_for,
     without_clock,
 )
-from tests.app.test_reproducible import without_timing
 from tests.router_stub import DownRouter
+from tests.utils.answers import without_timing
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.
 pytestmark = pytest.mark.slow

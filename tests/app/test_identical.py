@@ -30,13 +30,12 @@ from core.routing.effort import Effort
 from core.routing.evrp import solve_evrptw
 from testbed.evrptw import FOLDER, read
 from tests.app.apps import app_client
+from tests.utils.answers import without_timing
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.
 pytestmark = pytest.mark.slow
 
 RECORDED = Path(__file__).with_name("identical_answers.json")
-#: The answer's fields that report timing: they differ between runs.
-TIMING = ("runtime_s", "route_days_per_s")
 #: Significant digits a number is compared to (a least-squares fit's last digits move).
 DIGITS = 9
 #: The id a stored answer is given (a calibration is kept to be named later).
@@ -64,18 +63,7 @@ def cases() -> list[tuple[str, str, dict[str, Any]]]:
 
 def fingerprint(answer: Any) -> str:
     """The answer's SHA-256 without its timing, its numbers to :data:`DIGITS` digits."""
-
-    def canonical(value: Any) -> Any:
-        if isinstance(value, dict):
-            return {k: canonical(v) for k, v in value.items() if k not in TIMING}
-        if isinstance(value, list):
-            return [canonical(v) for v in value]
-        if isinstance(value, float):
-            return float(f"{value:.{DIGITS}g}")
-        return value
-
-    text = json.dumps(canonical(answer), sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()
+    return hashlib.sha256(without_timing(answer, DIGITS).encode()).hexdigest()
 
 
 def answer(client: TestClient, path: str, body: dict[str, Any]) -> Any:

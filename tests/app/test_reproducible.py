@@ -25,13 +25,12 @@ from core.planning.model import default_work_s
 from testbed.services import Server, busy_core
 from tests.app.apps import app_client
 from tests.app.test_jobs import submit, wait_for
+from tests.utils.answers import without_timing
 
 #: Starts servers or outside services, or runs full searches: make check, not make test.
 pytestmark = pytest.mark.slow
 
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "integrators" / "rounds.md"
-#: The answer's fields that report timing: they differ between runs.
-TIMING = ("runtime_s",)
 
 
 def examples(path: str) -> list[tuple[str, dict[str, Any]]]:
@@ -43,19 +42,6 @@ def examples(path: str) -> list[tuple[str, dict[str, Any]]]:
 CASES = [
     (path, name, body) for path in ("/v1/plans", "/v1/fleet-plans") for name, body in examples(path)
 ]
-
-
-def without_timing(answer: Any) -> Any:
-    """The answer without its timing fields, as canonical JSON text."""
-
-    def strip(value: Any) -> Any:
-        if isinstance(value, dict):
-            return {k: strip(v) for k, v in value.items() if k not in TIMING}
-        if isinstance(value, list):
-            return [strip(v) for v in value]
-        return value
-
-    return json.dumps(strip(answer), sort_keys=True)
 
 
 @contextlib.contextmanager
