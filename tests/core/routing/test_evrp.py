@@ -19,7 +19,15 @@ import numpy as np
 import pytest
 
 from core.routing.effort import Effort
-from core.routing.evrp import EvrpInstance, VehicleKind, _Priced, _Search, _Solution, solve_evrptw
+from core.routing.evrp import (
+    EvrpInstance,
+    VehicleKind,
+    _above_routes,
+    _Priced,
+    _Search,
+    _Solution,
+    solve_evrptw,
+)
 from core.routing.stations import (
     NO_ROUTE,
     keeps_windows,
@@ -323,6 +331,30 @@ def test_a_small_instance_is_solved_as_well_as_every_split_and_order_allows():
     assert check(inst, routes) is None
 
 
+def test_step_1s_fixed_cost_puts_fewer_vehicles_first_whatever_the_routes():
+    """Every split of four customers into routes and every order (an asymmetric matrix): the
+    dearest routes of k vehicles cost less than the cheapest of k + 1 once each vehicle costs
+    :func:`_above_routes` — on a hundred customers a twentieth of the sum of all arcs, the
+    bound it replaced."""
+    rng = np.random.default_rng(7)
+    distance = rng.integers(1, 1000, size=(5, 5))
+    np.fill_diagonal(distance, 0)
+    fixed = _above_routes(distance)
+    costs: dict[int, list[int]] = {}
+    for labels in itertools.product(range(4), repeat=4):  # customer → its route's label
+        groups = [[c + 1 for c in range(4) if labels[c] == g] for g in set(labels)]
+        for orders in itertools.product(*(itertools.permutations(g) for g in groups)):
+            cost = sum(
+                sum(distance[a, b] for a, b in itertools.pairwise([0, *order, 0]))
+                for order in orders
+            )
+            costs.setdefault(len(groups), []).append(cost + fixed * len(groups))
+    for k in range(1, 4):
+        assert max(costs[k]) < min(costs[k + 1])
+    big = rng.integers(1, 1000, size=(101, 101))  # a hundred customers
+    assert _above_routes(big) < big.sum() / 20
+
+
 def test_the_search_starts_from_the_better_of_the_given_routes_and_its_own():
     """Routes found without charging may be poor with it: one customer per vehicle is worse
     than PyVRP's start, so the search starts from PyVRP's and ends where it ends alone."""
@@ -332,6 +364,21 @@ def test_the_search_starts_from_the_better_of_the_given_routes_and_its_own():
     from_poor = solve_evrptw(inst, effort, alone)
     assert from_poor == solve_evrptw(inst, effort)
     assert from_poor.vehicles < len(alone)
+
+
+def test_a_search_on_from_given_routes_alone_spends_nothing_on_pyvrp(monkeypatch):
+    """``own=False``: the given routes are the only start (no PyVRP, whose share of the work
+    goes to the search), and the answer is no worse than them; searched on from its own
+    answer, the search keeps what it had."""
+    import core.routing.evrp as evrp
+
+    inst = small()
+    alone = [(0, [c]) for c in inst.customers]
+    first = solve_evrptw(inst, Effort.starting_now(0.05, 60.0), alone, own=False)
+    assert first.vehicles < len(alone)
+    monkeypatch.setattr(evrp, "_customer_routes", None)  # called: a TypeError
+    on = solve_evrptw(inst, Effort.starting_now(0.05, 60.0), first.searched, own=False)
+    assert (on.vehicles, on.distance) <= (first.vehicles, first.distance + 1e-9)
 
 
 def test_a_vehicle_that_may_reload_serves_more_than_one_load():
