@@ -55,6 +55,7 @@ from core.arrays import FloatArray
 from core.routing import pyvrp_run
 from core.routing.effort import Effort, SearchEnd
 from core.routing.points import Closed, Span, full_spans
+from core.routing.pyvrp_run import above_routes
 from core.routing.stations import (
     NO_ROUTE,
     Charged,
@@ -330,7 +331,7 @@ def _customer_routes(instance: EvrpInstance, effort: Effort, charge_share: float
         pyvrp.VehicleType(
             num_available=min(kind.count, len(customers)),
             capacity=[math.floor(kind.capacity)],
-            fixed_cost=_above_routes(distance) if instance.fewest_vehicles else 0,
+            fixed_cost=above_routes(distance, len(customers)) if instance.fewest_vehicles else 0,
             tw_early=round(kind.ready * _SCALE),
             tw_late=round(min(kind.due, horizon) * _SCALE),
             profile=k,
@@ -350,16 +351,6 @@ def _customer_routes(instance: EvrpInstance, effort: Effort, charge_share: float
         (route.vehicle_type(), [customers[v.idx] for v in route.schedule() if v.is_client()])
         for route in result.best.routes()
     ]
-
-
-def _above_routes(distance: NDArray[np.int64]) -> int:
-    """A cost above any routes' (depot 0; every customer entered once, the depot once a
-    route, a route at most a customer): a vehicle's fixed cost that puts fewer vehicles first.
-    The least such bound, not the sum of all arcs: PyVRP evaluated moves 2.5–3 times as slowly
-    with that (E-VRPTW's rc104 as the fleet plan sends it, 10⁴ times the longest arc: 82
-    ns a move against 32)."""
-    entered = distance.max(axis=0)
-    return int(entered[1:].sum() + (len(distance) - 1) * entered[0]) + 1
 
 
 class _Priced:

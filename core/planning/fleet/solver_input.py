@@ -9,6 +9,7 @@ import numpy as np
 
 from core.planning.day.start_state import start_payload_kg
 from core.planning.search.feasibility import Feasibility
+from core.routing.pyvrp_run import above_routes
 from core.routing.units import energy_units_down, energy_units_up, payload_units_down
 from core.routing.vrp import RoutingInput, VehicleSpec
 
@@ -23,11 +24,8 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
     """
     day = rules.day
     kinds = list({id(e): e for e in day.estimates}.values())
-    cost_bound = 0
-    for kind in kinds:
-        largest = kind.arc_cost.max(axis=1)
-        cost_bound = max(cost_bound, int(largest.sum() + largest[0] * len(day.shifts)))
-    fixed = cost_bound + 1 if minimize_vehicles else 0
+    bound = max((above_routes(kind.arc_cost, len(day.shifts)) for kind in kinds), default=0)
+    fixed = bound if minimize_vehicles else 0
     # one matrix per kind of van, shared by its vans (and so by the solvers' vehicle types)
     energies = {id(kind): energy_units_up(kind.energy_j) for kind in kinds}
     specs = []
@@ -71,5 +69,5 @@ def routing_input(rules: Feasibility, minimize_vehicles: bool) -> RoutingInput:
         demand_g=demand.astype(np.int64),
         vehicles=specs,
         horizon_s=day.horizon_s,
-        drop_penalty=(cost_bound + 1) * (len(day.shifts) + 2),
+        drop_penalty=bound * (len(day.shifts) + 2),
     )

@@ -22,7 +22,6 @@ from core.routing.effort import Effort
 from core.routing.evrp import (
     EvrpInstance,
     VehicleKind,
-    _above_routes,
     _Priced,
     _Search,
     _Solution,
@@ -329,30 +328,6 @@ def test_a_small_instance_is_solved_as_well_as_every_split_and_order_allows():
     assert solution.distance == pytest.approx(distance, rel=1e-6)
     routes = [[(v.place, v.charge) for v in route.visits] for route in solution.routes]
     assert check(inst, routes) is None
-
-
-def test_step_1s_fixed_cost_puts_fewer_vehicles_first_whatever_the_routes():
-    """Every split of four customers into routes and every order (an asymmetric matrix): the
-    dearest routes of k vehicles cost less than the cheapest of k + 1 once each vehicle costs
-    :func:`_above_routes` — on a hundred customers a twentieth of the sum of all arcs, the
-    bound it replaced."""
-    rng = np.random.default_rng(7)
-    distance = rng.integers(1, 1000, size=(5, 5))
-    np.fill_diagonal(distance, 0)
-    fixed = _above_routes(distance)
-    costs: dict[int, list[int]] = {}
-    for labels in itertools.product(range(4), repeat=4):  # customer → its route's label
-        groups = [[c + 1 for c in range(4) if labels[c] == g] for g in set(labels)]
-        for orders in itertools.product(*(itertools.permutations(g) for g in groups)):
-            cost = sum(
-                sum(distance[a, b] for a, b in itertools.pairwise([0, *order, 0]))
-                for order in orders
-            )
-            costs.setdefault(len(groups), []).append(cost + fixed * len(groups))
-    for k in range(1, 4):
-        assert max(costs[k]) < min(costs[k + 1])
-    big = rng.integers(1, 1000, size=(101, 101))  # a hundred customers
-    assert _above_routes(big) < big.sum() / 20
 
 
 def test_the_search_starts_from_the_better_of_the_given_routes_and_its_own():
