@@ -19,7 +19,8 @@ fitted, the charge points booked across the fleet, and repaired where the simula
    without part of the charging time in the arcs (when every van leaves the depot), and the
    routes the fleet's search found without charging (the stops left out inserted where they
    cost least), each with half the work, keeps the better, and serves every stop it can,
-   then fewest vans (when asked), then the objective.
+   then fewest vans (when asked), then the objective. When its routes hold (3.), the work
+   kept for searching again with a smaller battery searches on from them.
 3. **Verification**: each route is simulated with its charges fitted to what the simulation
    says each stretch takes (:func:`core.planning.day.recharge.with_charges`), the charge points
    free only between the other vans' charges as simulated (:class:`Bookings`: the search
@@ -384,7 +385,9 @@ def charging_routes(
     earlier by its lateness (:func:`_tightened`), and the search starts
     again from ``routes`` (which hold without charging; the routes it found may not hold with
     the smaller battery even when charged), at most
-    :data:`CHARGING_ROUNDS` times; the best verified routes are kept."""
+    :data:`CHARGING_ROUNDS` times; the best verified routes are kept. When the first
+    search's routes hold, the work the other rounds would have had searches on from them
+    (without PyVRP's starts: the routes are the best the search knows)."""
     routes, results = found
     charging = charging_instance(
         day, times_s, minimize_vehicles, battery_margin(day, routes, results)
@@ -403,12 +406,20 @@ def charging_routes(
         solution = solve_evrptw(charging.instance, effort.share(share), initial)
         ends.append(solution.ended)
         verified, short = _verified(day, charging, solution)
-        verified = replace(verified, ended=combined(ends))
         if best is None or _ranked(day, verified, minimize_vehicles) < _ranked(
             day, best, minimize_vehicles
         ):
             best = verified
-        if not short or solution.ended == "time_limit":
+        if solution.ended == "time_limit":
+            break
+        if not short:
+            if not round_:  # the rounds' work unspent: searched on from these routes
+                rest = effort.share(1.0 - FIRST_SHARE)
+                solution = solve_evrptw(charging.instance, rest, solution.searched, own=False)
+                ends.append(solution.ended)
+                further, _ = _verified(day, charging, solution)
+                if _ranked(day, further, minimize_vehicles) < _ranked(day, best, minimize_vehicles):
+                    best = further
             break
         charging = replace(charging, instance=_tightened(charging.instance, short))
     assert best is not None

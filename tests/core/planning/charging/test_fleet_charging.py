@@ -32,6 +32,7 @@ from core.planning.fleet.planner import _failure, _given_to_idle, plan_fleet
 from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
 from core.planning.search.feasibility import Feasibility
 from core.routing.effort import Effort
+from core.routing.evrp import solve_evrptw
 from tests.core.planning.day.test_breaks import driving_between_breaks_s
 from tests.core.planning.day.test_recharge import summer_day
 from tests.utils.fleets import DEPOT
@@ -373,4 +374,28 @@ def test_with_fewer_vans_first_the_charging_search_starts_before_idle_vans_take_
         assert events[:2] == ["charging", "idle"]
     else:
         assert events[0] == "idle"
+    assert all(r.plan.battery.feasible for r in result.routes)
+
+
+def test_when_the_first_charging_search_holds_its_rounds_work_searches_on_from_it(monkeypatch):
+    """The work kept for searching again with a smaller battery is not left unspent when the
+    first search's routes hold: a second search starts from those routes alone (not from
+    PyVRP's again) with that work, and the answer is the better verified."""
+    import core.planning.charging.fleet_charging as charging
+
+    calls = []
+
+    def spied(instance, effort, initial=None, own=True):
+        solution = solve_evrptw(instance, effort, initial, own)
+        calls.append((effort.work_s, initial, own, solution))
+        return solution
+
+    monkeypatch.setattr(charging, "solve_evrptw", spied)
+    day = summer_day(None)
+    result = plan_fleet(fleet(day, [day.van], chargers=[FAST], work_s=1))
+    (first_s, _, first_own, first), (rest_s, start, own, _) = calls
+    assert first_own and not own
+    assert start == first.searched and start
+    whole_s = first_s / charging.FIRST_SHARE
+    assert rest_s == pytest.approx(whole_s * (1 - charging.FIRST_SHARE))
     assert all(r.plan.battery.feasible for r in result.routes)
