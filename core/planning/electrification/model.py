@@ -122,8 +122,9 @@ class Candidate(Params):
 
 
 class ChargeOption(Params):
-    """A charge a day may take: at the depot at lunch, or on the way — at most ``minutes`` at
-    ``power_kw`` (the van's charging power cap and efficiency; the curve's flat part)."""
+    """A charge a day may take: at the depot at lunch, or on the way — at most ``minutes`` at a
+    charger of ``power_kw``, along the van's charging curve from its reserve (capped by the
+    charger and the van, at its efficiency: :func:`core.physics.charging.charge_curve`)."""
 
     where: Literal["depot", "on_the_way"] = Field(
         ..., description="At the depot (back at lunch) or at a charger on the way."

@@ -5,7 +5,8 @@ a date's weather is the climatology of the depot's place, :mod:`core.physics.wea
 
 A day is covered when the battery keeps its reserve all day
 (:class:`core.physics.battery.BatteryVerdict`: from the state of charge never clipped); with
-charges allowed, also when the charge it lacks fits in them (:func:`topped_up`). Telematics
+charges allowed, also when the charge it lacks fits in them along the van's charging curve
+(:func:`topped_up`). Telematics
 "EV suitability" assessments (Geotab's EVSA) leave the refrigeration unit out; here it is in,
 with every door opening, and the cold chain's verdict of each day.
 """
@@ -25,7 +26,8 @@ from pydantic import ValidationError
 from core.clock import departure
 from core.exceptions import CoreError, InvalidParameterError, ServiceUnavailableError
 from core.params import Location, Stop, VanParams, plain_rule, product_band
-from core.physics.battery import BatteryVerdict
+from core.physics.battery import JOULES_PER_KWH, BatteryVerdict
+from core.physics.charging import WATTS_PER_KW, charge_curve
 from core.physics.cold_chain import box_check
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
 from core.physics.weather import HourlyWeather, WeatherService
@@ -444,14 +446,17 @@ def _day(
 def topped_up(battery: BatteryVerdict, van: VanParams, chargers: Sequence[ChargeOption]) -> bool:
     """Whether a day with this ``battery`` verdict is covered with ``chargers``: it keeps its
     reserve on one charge, or the charge it lacks (``-margin_kwh``) is stored within the
-    charges' minutes at their power, capped by the van's, at the van's charging efficiency."""
+    charges' minutes — each along the van's charging curve at the charger's power from the
+    reserve, where a day that lacks charge takes it (:func:`core.physics.charging.charge_curve`:
+    capped by the charger and the van, at its efficiency, on the day's usable capacity), the
+    one charge-time model the planners and their verification use too."""
     if battery.feasible:
         return True
-    stored_kwh = sum(
-        min(c.power_kw, van.battery.max_charge_power_kw)
-        * van.battery.charging_efficiency
-        * c.minutes
-        / 60.0
+    share = battery.usable_capacity_kwh / van.battery.usable_capacity_kwh
+    stored_j = sum(
+        charge_curve(van.battery, c.power_kw * WATTS_PER_KW, share).stored_j(
+            van.battery.min_soc, c.minutes * 60.0
+        )
         for c in chargers
     )
-    return bool(chargers) and -battery.margin_kwh <= stored_kwh
+    return bool(chargers) and -battery.margin_kwh * JOULES_PER_KWH <= stored_j

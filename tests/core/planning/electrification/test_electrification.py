@@ -6,6 +6,7 @@ the dates checked."""
 from __future__ import annotations
 
 import datetime as dt
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -165,6 +166,23 @@ def test_a_charge_covers_the_days_whose_lack_it_stores():
     result = study(problem(r, short, chargers=[LUNCH]))
     outcome = result.routes[0].candidates[0]
     assert outcome.days_feasible_with_charging >= outcome.days_feasible + 1
+
+
+def test_a_charge_stores_along_the_vans_charging_curve():
+    """The same 30 min at a 22 kW charger store half as much for a van whose curve takes
+    11 kW (its own curve, not the charger's power: the model the planners use): a day lacking
+    three quarters of 22 × 0.5 × efficiency is covered by the van that takes 22 kW only."""
+    van = frozen_van()
+    r = route()
+    (day,) = days_of(problem(r, van), r, van, [MONTHS[6]])
+    eff = van.battery.charging_efficiency
+    lacking = replace(day.battery, feasible=False, margin_kwh=-0.75 * 22 * 0.5 * eff)
+    flat = [{"soc": 0.0, "power_kw": 11.0}, {"soc": 1.0, "power_kw": 11.0}]
+    curved = type(van.battery).model_validate(van.battery.model_dump() | {"charging_curve": flat})
+    slow = van.model_copy(update={"battery": curved})
+    assert van.battery.max_charge_power_kw >= 22
+    assert topped_up(lacking, van, [LUNCH])
+    assert not topped_up(lacking, slow, [LUNCH])
 
 
 def test_the_depot_recharges_the_days_driven_on_one_charge():
