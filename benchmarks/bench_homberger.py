@@ -255,17 +255,18 @@ def profile_table(name: str = "R1_10_1") -> None:
     from app.settings import Settings
     from core.planning.fleet import planner as fleet
     from core.planning.search import day
+    from core.planning.search import fleet as fleet_search
 
     stages = _Stages()
     stages.wrap(fleet, "legs_for", "matrix (checked, legs)")
     stages.wrap(fleet, "client_legs_too_fast", "matrix: arcs faster than a van")
     stages.wrap(fleet, "fleet_day", "estimates (per kind of van)")
-    stages.wrap(fleet, "routing_input", "solver input")
-    stages.wrap(fleet, "solve_routes", "search (PyVRP, OR-Tools)")
+    stages.wrap(fleet_search, "routing_input", "solver input")
+    stages.wrap(fleet_search, "solve_routes", "search (PyVRP, OR-Tools)")
     stages.wrap(day.FleetDay, "simulate", "verification (simulated days)")
-    stages.wrap(fleet, "_repair", "repair")
-    stages.wrap(fleet, "_given_to_idle", "idle vans")
-    stages.wrap(fleet, "explain", "reasons of the unserved")
+    stages.wrap(fleet_search, "_repair", "repair")
+    stages.wrap(fleet_search, "_given_to_idle", "idle vans")
+    stages.wrap(fleet_search, "explain", "reasons of the unserved")
     instance = homberger(name)
     text = json.dumps(fleet_request(instance, BUDGET_S))
     started = time.perf_counter()

@@ -1,2 +1,2 @@
-"""A fleet's day: the search and its verification (:mod:`.planner`), the routing solver's
-input (:mod:`.solver_input`), the reasons of the stops it leaves out (:mod:`.explain`)."""
+"""A fleet's day: the request checked, the search run and its answer built (:mod:`.planner`;
+the search itself is :mod:`core.planning.search.fleet`)."""

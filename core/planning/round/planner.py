@@ -3,7 +3,7 @@
 1. legs between every ordered pair (:mod:`core.routing.geo`: the client's matrix, a road
    router's table or the estimate); 2. the order of the stops on the chosen objective: the
    round trip (:mod:`core.routing.tsp`), or, when stops have time windows, the fleet search of
-   :mod:`core.planning.fleet.planner` with this one van; 3. the day driven and simulated in full
+   :mod:`core.planning.search.fleet` with this one van; 3. the day driven and simulated in full
    (:mod:`core.planning.day.verify`), with the weather for the round's span (a forecast service,
    the request, or the climatology).
 """
@@ -38,7 +38,6 @@ from core.planning.day.scene import (
 from core.planning.day.start_state import START_ID, check_start, path_tour, under_way
 from core.planning.day.timeline import client_legs_too_fast, windows_after
 from core.planning.day.verify import Drive
-from core.planning.fleet.planner import search
 from core.planning.itinerary import Itinerary
 from core.planning.model import (
     MAX_ROUND_S,
@@ -51,6 +50,7 @@ from core.planning.model import (
 )
 from core.planning.round.reloads import check_payload, with_reloads
 from core.planning.search.day import VanShift, fleet_day, leg_roads
+from core.planning.search.fleet import search
 from core.routing.effort import Effort, SearchEnd, combined
 from core.routing.geo import Legs
 from core.routing.roads import LegRoute, RememberingRouter, RoadRouter

@@ -332,7 +332,7 @@ def test_a_stop_the_search_left_out_goes_to_an_idle_van_that_serves_it_alone(mon
     """The trust issue: stops were left out as "time_window" that one of 19 idle vans could
     serve on a round of its own. Whatever the search leaves out (here: it ran out of time
     before placing W3), an idle van that serves the stop alone, by the simulation, takes it."""
-    from core.planning.fleet import planner as fleet_module
+    from core.planning.search import fleet as fleet_module
     from core.routing.vrp import RoutingOutcome
 
     stops, matrix = two_clusters(time_windows=[window("09:00", "09:20")])
@@ -353,7 +353,7 @@ def test_a_stop_the_search_left_out_goes_to_an_idle_van_that_serves_it_alone(mon
 
 
 def test_a_stop_an_idle_van_cannot_serve_alone_says_what_its_simulation_broke(monkeypatch):
-    from core.planning.fleet import planner as fleet_module
+    from core.planning.search import fleet as fleet_module
     from core.routing.vrp import RoutingOutcome
 
     stops, matrix = two_clusters(time_windows=[window("09:00", "09:20")])

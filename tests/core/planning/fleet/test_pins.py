@@ -8,8 +8,8 @@ import pytest
 
 from core.exceptions import CoreError
 from core.params import ChargePoint
-from core.planning.charging.fleet_charging import charging_instance
 from core.planning.fleet.planner import plan_fleet
+from core.planning.search.charging.fleet_charging import charging_instance
 from tests.core.planning.fleet.test_fleet import assert_holds
 from tests.utils.fleets import DEPOT, day_of, fleet, two_clusters, van
 

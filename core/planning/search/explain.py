@@ -57,7 +57,7 @@ def _full(rules: Feasibility, node: int, routes: list[list[int]]) -> tuple[Unass
     """A stop some van could serve on a round of its own, left out because the fleet is full:
     the rule that stops it from joining any van's route at its best place, the one most vans
     share. A van with no route that would serve it alone has been given it (or its
-    simulation said why not, :func:`core.planning.fleet.planner.search`): the vans without a route
+    simulation said why not, :func:`core.planning.search.fleet.search`): the vans without a route
     refuse it alone, and their reason comes first."""
     vans = rules.day.vans_for(node)
     idle = [why for v in vans if not routes[v] and (why := rules.alone(v, node))]

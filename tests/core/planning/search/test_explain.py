@@ -6,7 +6,7 @@ import numpy as np
 
 from core.params import Stop
 from core.planning.day.verify import Failure
-from core.planning.fleet.explain import explain
+from core.planning.search.explain import explain
 from core.planning.search.feasibility import Feasibility
 from tests.utils.fleets import day_of, fleet, two_clusters, van
 

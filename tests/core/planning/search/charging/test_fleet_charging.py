@@ -14,7 +14,11 @@ import numpy as np
 import pytest
 
 from core.params import BatteryParams, ChargePoint, Charger, Depot, Stop, TimeWindow
-from core.planning.charging.fleet_charging import (
+from core.planning.day.timeline import MAX_DRIVING_S
+from core.planning.day.verify import Failure
+from core.planning.fleet.planner import plan_fleet
+from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
+from core.planning.search.charging.fleet_charging import (
     BATTERY_MARGIN,
     MIN_BATTERY_MARGIN,
     MIN_TIGHTEN_S,
@@ -26,11 +30,8 @@ from core.planning.charging.fleet_charging import (
     battery_margin,
     charging_instance,
 )
-from core.planning.day.timeline import MAX_DRIVING_S
-from core.planning.day.verify import Failure
-from core.planning.fleet.planner import _failure, _given_to_idle, plan_fleet
-from core.planning.model import FleetProblem, FleetVehicle, RoundFields, fields_of
 from core.planning.search.feasibility import Feasibility
+from core.planning.search.fleet import _failure, _given_to_idle
 from core.routing.effort import Effort
 from core.routing.evrp import solve_evrptw
 from tests.core.planning.day.test_breaks import driving_between_breaks_s
@@ -165,7 +166,7 @@ def test_a_stop_the_charging_verification_left_out_goes_to_an_idle_van(monkeypat
     fleet serves every stop rather than fall back on the routes found without charging (vans
     of 5 kWh: a cluster of three takes 3.3 kWh, all six 7.8 kWh; the second van's shift,
     08:00–08:30, leaves it time for one stop — without charging the two serve four)."""
-    import core.planning.fleet.planner as planner
+    import core.planning.search.fleet as planner
 
     searched = planner.charging_routes
     dropped: list[str] = []
@@ -352,7 +353,7 @@ def test_with_fewer_vans_first_the_charging_search_starts_before_idle_vans_take_
     28 stops took 5 s of the 60 and left the charging search none to give its last stop to an
     idle van); they are, after it, if its routes do no better. Distance first: idle vans take
     them first, and charging follows only for stops still out for their battery."""
-    import core.planning.fleet.planner as planner
+    import core.planning.search.fleet as planner
 
     events: list[str] = []
 
@@ -381,7 +382,7 @@ def test_when_the_first_charging_search_holds_its_rounds_work_searches_on_from_i
     """The work kept for searching again with a smaller battery is not left unspent when the
     first search's routes hold: a second search starts from those routes alone (not from
     PyVRP's again) with that work, and the answer is the better verified."""
-    import core.planning.charging.fleet_charging as charging
+    import core.planning.search.charging.fleet_charging as charging
 
     calls = []
 
