@@ -49,6 +49,10 @@ from core.routing.tsp import SolverStatus
 
 #: How the answers name the depot's charger.
 DEPOT_CHARGER_ID = "depot"
+#: The id of the van's position in the tour and the legs (a day planned from where it is).
+START_ID = "start"
+#: Sampling interval of a planned day's simulation [s].
+PLAN_DT_S = 1.0
 #: Longest round the planner simulates [s] (a week): longer inputs are mistakes.
 MAX_ROUND_S = 7 * 86_400.0
 #: Most vans in one fleet plan (the server's setting may allow fewer).

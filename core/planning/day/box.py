@@ -16,8 +16,8 @@ from core.physics.battery import JOULES_PER_KWH
 from core.physics.cargo import BoxResult
 from core.physics.cold_chain import box_check, goods_history
 from core.physics.simulate import SimulationResult
-from core.planning.day.timeline import PLAN_DT_S
 from core.planning.model import (
+    PLAN_DT_S,
     Baseline,
     ColdChainResult,
     DeliveredGoods,

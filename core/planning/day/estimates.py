@@ -21,8 +21,7 @@ from core.physics.cargo import door_heat_w, refrigeration_cop
 from core.physics.cycles import generate_leg
 from core.physics.simulate import CONSUMERS, Along, SimulationResult, simulate
 from core.physics.vehicle import step_traction_power_w
-from core.planning.day.timeline import PLAN_DT_S
-from core.planning.model import PlanProblem
+from core.planning.model import PLAN_DT_S, PlanProblem
 from core.routing.geo import MAX_LEG_GRADE, STREET_TYPE_NAMES, Legs
 from core.routing.units import ENERGY_UNIT_J
 

@@ -11,8 +11,7 @@ from dataclasses import dataclass
 from core.exceptions import InvalidStopsError, OffRoadError
 from core.params import ChargePoint, Place
 from core.physics.weather import Forecast, WeatherService, forecast_for
-from core.planning.day.start_state import START_ID
-from core.planning.model import PlanProblem, RoundFields
+from core.planning.model import START_ID, PlanProblem, RoundFields
 from core.routing.geo import Legs, build_legs
 from core.routing.roads import RoadRouter
 

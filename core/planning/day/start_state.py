@@ -15,12 +15,9 @@ from numpy.typing import NDArray
 
 from core.exceptions import InvalidParameterError
 from core.params import MIN_SOC_WINDOW
-from core.planning.model import PlanProblem, RoundFields
+from core.planning.model import START_ID, PlanProblem, RoundFields
 from core.routing.effort import Effort
 from core.routing.tsp import Tour, solve_path
-
-#: The id of the van's position in the tour and the legs.
-START_ID = "start"
 
 
 def check_start(

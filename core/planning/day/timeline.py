@@ -41,12 +41,9 @@ from core.physics.motor import power_limited
 from core.physics.simulate import MAX_SPEED_MPS, Along
 from core.planning.day.start_state import start_payload_kg
 from core.planning.itinerary import ChargeVisit, Itinerary, Windows
-from core.planning.model import PlanProblem
+from core.planning.model import PLAN_DT_S, PlanProblem
 from core.routing.geo import STREET_TYPE_NAMES, Legs, street_type_by_speed
 from core.routing.roads import LegRoute, bearing_deg
-
-#: Sampling interval of the day's simulation [s].
-PLAN_DT_S = 1.0
 
 
 def next_window(arrival_s: float, windows_s: Windows) -> tuple[float, float] | None:

@@ -24,7 +24,6 @@ from core.planning.day.box import cold_chain, deliveries, refrigeration, tempera
 from core.planning.day.scene import Scene, charge_points
 from core.planning.day.start_state import box_start_c, product_start_c, start_payload_kg
 from core.planning.day.timeline import (
-    PLAN_DT_S,
     Timeline,
     build_timeline,
     later_departure_s,
@@ -33,6 +32,7 @@ from core.planning.day.timeline import (
 from core.planning.itinerary import Itinerary, Windows
 from core.planning.model import (
     DEPOT_CHARGER_ID,
+    PLAN_DT_S,
     BreakResult,
     ChargeResult,
     ColdChainResult,

@@ -32,7 +32,7 @@ from core.physics.cold_chain import box_check
 from core.physics.simulate import CONSUMERS, SimulationResult, simulate, with_battery
 from core.physics.weather import HourlyWeather, WeatherService
 from core.planning.day.scene import legs_for, round_places
-from core.planning.day.timeline import PLAN_DT_S, Timeline, build_timeline, rest_after
+from core.planning.day.timeline import Timeline, build_timeline, rest_after
 from core.planning.electrification.model import (
     WEEKDAYS,
     ChargeOption,
@@ -52,7 +52,7 @@ from core.planning.electrification.summary import (
     route_outcome,
 )
 from core.planning.itinerary import Itinerary
-from core.planning.model import PlanProblem
+from core.planning.model import PLAN_DT_S, PlanProblem
 from core.planning.round.planner import check
 from core.planning.search.day import leg_roads
 from core.routing.geo import great_circle_m

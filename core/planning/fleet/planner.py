@@ -42,9 +42,10 @@ from core.params import Place
 from core.physics.simulate import CONSUMERS
 from core.physics.weather import WeatherService, forecast_for
 from core.planning.day.scene import Scene, legs_for, round_field
-from core.planning.day.start_state import START_ID, check_start, check_start_id, under_way
+from core.planning.day.start_state import check_start, check_start_id, under_way
 from core.planning.day.timeline import client_legs_too_fast
 from core.planning.model import (
+    START_ID,
     FleetProblem,
     FleetResult,
     PlanProblem,

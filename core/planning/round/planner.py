@@ -35,12 +35,13 @@ from core.planning.day.scene import (
     round_places,
     weather_service_for,
 )
-from core.planning.day.start_state import START_ID, check_start, path_tour, under_way
+from core.planning.day.start_state import check_start, path_tour, under_way
 from core.planning.day.timeline import client_legs_too_fast, windows_after
 from core.planning.day.verify import Drive
 from core.planning.itinerary import Itinerary
 from core.planning.model import (
     MAX_ROUND_S,
+    START_ID,
     PlanProblem,
     PlanResult,
     Solved,

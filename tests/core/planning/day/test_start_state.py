@@ -11,9 +11,15 @@ import pytest
 
 from core.exceptions import InvalidParameterError
 from core.params import RoadMatrix, TimeWindow
-from core.planning.day.start_state import START_ID
 from core.planning.fleet.planner import plan_fleet
-from core.planning.model import FleetProblem, FleetVehicle, RoundFields, StartState, fields_of
+from core.planning.model import (
+    START_ID,
+    FleetProblem,
+    FleetVehicle,
+    RoundFields,
+    StartState,
+    fields_of,
+)
 from core.planning.round.planner import plan
 from tests.core.planning.day.test_recharge import summer_day
 
